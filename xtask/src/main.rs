@@ -1,1 +1,37 @@
-fn main(){}
+//! Project tasks: `cargo xtask <task>`.
+//!
+//! - `fmu`    build the release library and package `target/fmu/ModalMassSpring.fmu`
+//! - `run`    build the FMU and run the main job through fmpy (summary + plot)
+//! - `test`   every test: Rust (cargo test) and Python (pytest + fmpy)
+//! - `setup`  install what the other tasks need (libclang, Python venv with fmpy)
+
+mod fmu;
+mod run;
+mod setup;
+
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let (task, rest) = match args.split_first() {
+        Some((t, r)) => (t.as_str(), r),
+        None => ("help", &[][..]),
+    };
+    let result = match task {
+        "fmu" => fmu::main(rest),
+        "run" => run::run(rest),
+        "test" => run::test(rest),
+        "setup" => setup::main(rest),
+        _ => {
+            eprintln!("usage: cargo xtask <fmu|run|test|setup> [options]");
+            return ExitCode::from(2);
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("xtask {task}: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
