@@ -1,0 +1,266 @@
+//! Physics core checks: modes, frequencies, modal vs full space, weights,
+//! sub-stepping, snapshots.
+
+use modal_mass_spring::physics::forces::StiffnessPattern;
+use modal_mass_spring::physics::modes::ModalBasis;
+use modal_mass_spring::physics::scene::Scene;
+use modal_mass_spring::physics::*;
+
+fn scene(name: &str) -> SceneParams {
+    SceneParams::canonical(name).unwrap()
+}
+
+fn solver(reduction: Reduction, integrator: Integrator, n_modes: usize) -> SolverParams {
+    SolverParams { reduction, integrator, n_modes, ..SolverParams::default() }
+}
+
+fn basis(p: &SceneParams, r: usize) -> (Scene, StiffnessPattern, Vec<f64>, ModalBasis) {
+    let s = Scene::build(p).unwrap();
+    let pat = StiffnessPattern::new(&s);
+    let mut k0 = vec![0.0; pat.nnz()];
+    pat.add_tangent(&s, &s.rest, 1.0, &mut k0);
+    let b = ModalBasis::lowest(&s, &pat, &k0, r).unwrap();
+    (s, pat, k0, b)
+}
+
+#[test]
+fn modes_are_mass_orthonormal_and_diagonalise_k() {
+    for name in ["paper-2d-top-row", "paper-3d-sheet"] {
+        let (s, pat, k0, b) = basis(&scene(name), 12);
+        let (n, r) = (b.n, b.r);
+        let mut kphi = vec![0.0; n];
+        for i in 0..r {
+            let col_i: Vec<f64> = (0..n).map(|k| b.phi[k * r + i]).collect();
+            pat.sym_matvec(&k0, &col_i, &mut kphi);
+            for j in 0..r {
+                let mij: f64 = (0..n).map(|k| b.phi[k * r + j] * s.dof_mass[k] * col_i[k]).sum();
+                let kij: f64 = (0..n).map(|k| b.phi[k * r + j] * kphi[k]).sum();
+                let delta = if i == j { 1.0 } else { 0.0 };
+                assert!((mij - delta).abs() < 1e-10, "{name}: Phi^T M Phi [{i},{j}] = {mij}");
+                let want = delta * b.lambda[i];
+                assert!((kij - want).abs() < 1e-9 * b.lambda[r - 1], "{name}: Phi^T K Phi [{i},{j}] = {kij}, want {want}");
+            }
+        }
+        assert!(b.lambda.windows(2).all(|w| w[0] <= w[1]));
+        assert!(b.lambda[0] > 0.0, "{name}: lowest eigenvalue {}", b.lambda[0]);
+    }
+}
+
+/// Period from upward zero crossings of a sampled signal (linear interpolation).
+fn measured_omega(samples: &[f64], dt: f64) -> f64 {
+    let mut crossings = Vec::new();
+    for k in 1..samples.len() {
+        if samples[k - 1] < 0.0 && samples[k] >= 0.0 {
+            let frac = samples[k - 1] / (samples[k - 1] - samples[k]);
+            crossings.push((k as f64 - 1.0 + frac) * dt);
+        }
+    }
+    assert!(crossings.len() >= 4, "too few oscillations: {}", crossings.len());
+    let periods = (crossings.len() - 1) as f64;
+    2.0 * std::f64::consts::PI * periods / (crossings[crossings.len() - 1] - crossings[0])
+}
+
+/// Starts `sim` at amplitude `eps` of mode j (zero gravity), records its coordinate.
+fn oscillate(sim: &mut Simulator, state: Vec<f64>, j: usize, dt: f64, steps: usize) -> Vec<f64> {
+    let mut t = sim.tunables().clone();
+    t.gravity = [0.0; 3];
+    sim.restore(&Snapshot { time: 0.0, state, tunables: t }).unwrap();
+    (0..steps)
+        .map(|_| {
+            sim.do_step(dt).unwrap();
+            sim.modal_coordinates()[j]
+        })
+        .collect()
+}
+
+#[test]
+fn small_amplitude_full_space_frequencies_equal_mode_frequencies() {
+    let p = scene("paper-2d-top-row");
+    let r = 6;
+    let (_, _, _, b) = basis(&p, r);
+    let n = b.n;
+    for j in [0, 5] {
+        let eps = 1e-6;
+        let omega = b.lambda[j].sqrt();
+        let mut sim = Simulator::new(&p, &solver(Reduction::Full, Integrator::NewmarkImplicit, r), &Tunables::physical(r)).unwrap();
+        assert!((sim.mode_frequencies()[j] - omega).abs() < 1e-12 * omega);
+        let mut state = vec![0.0; 3 * n];
+        for k in 0..n {
+            state[k] = eps * b.phi[k * r + j];
+            state[2 * n + k] = -b.lambda[j] * eps * b.phi[k * r + j];
+        }
+        // Shift so the signal oscillates about zero: start at a velocity peak.
+        let period = 2.0 * std::f64::consts::PI / omega;
+        let dt = period / 400.0;
+        let samples = oscillate(&mut sim, state, j, dt, 400 * 8);
+        let measured = measured_omega(&samples, dt);
+        // Average-acceleration Newmark lengthens the period by (omega dt)^2 / 12.
+        let expected = omega / (1.0 + (omega * dt).powi(2) / 12.0);
+        assert!((measured - expected).abs() < 2e-4 * omega, "mode {j}: measured {measured}, modeFrequencies {omega}");
+    }
+}
+
+fn run(p: &SceneParams, s: &SolverParams, t: &Tunables, h: f64, steps: usize) -> Vec<Vec<f64>> {
+    let mut sim = Simulator::new(p, s, t).unwrap();
+    (0..steps)
+        .map(|_| {
+            sim.do_step(h).unwrap();
+            sim.positions().to_vec()
+        })
+        .collect()
+}
+
+#[test]
+fn all_modes_reproduce_full_space_to_round_off() {
+    for (name, steps) in [("paper-2d-top-row", 50), ("paper-2d-top-corners", 50), ("paper-3d-sheet", 50)] {
+        let p = scene(name);
+        let n = Scene::build(&p).unwrap().n_dofs();
+        for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit] {
+            let mut t = Tunables::physical(n);
+            t.damping_alpha = 0.3;
+            t.damping_beta = 1e-3;
+            let modal = run(&p, &solver(Reduction::Modal, integrator, n), &t, 0.01, steps);
+            let full = run(&p, &solver(Reduction::Full, integrator, n), &t, 0.01, steps);
+            let rest = Simulator::new(&p, &solver(Reduction::Full, integrator, 0), &Tunables::physical(0)).unwrap().positions().to_vec();
+            let disp = full.last().unwrap().iter().zip(&rest).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            let diff = modal.iter().flatten().zip(full.iter().flatten()).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(disp > 1e-3, "{name}: the sheet must move, max displacement {disp}");
+            assert!(diff < 1e-9 * disp.max(1.0), "{name} {integrator:?}: modal vs full differ by {diff} (displacement {disp})");
+        }
+    }
+}
+
+#[test]
+fn zero_weight_keeps_its_mode_at_rest() {
+    let p = scene("paper-2d-top-row");
+    for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit] {
+        // Mode 1 is the vertical stretch that gravity drives hardest.
+        let mut free = Simulator::new(&p, &solver(Reduction::Modal, integrator, 4), &Tunables::physical(4)).unwrap();
+        let mut t = Tunables::physical(4);
+        t.mode_weights = vec![1.0, 0.0, 1.0, 1.0];
+        let mut sim = Simulator::new(&p, &solver(Reduction::Modal, integrator, 4), &t).unwrap();
+        for _ in 0..100 {
+            free.do_step(0.01).unwrap();
+            sim.do_step(0.01).unwrap();
+            assert_eq!(sim.modal_coordinates()[1], 0.0);
+        }
+        assert!(free.modal_coordinates()[1].abs() > 1e-2);
+        assert!(sim.modal_coordinates()[3].abs() > 1e-5);
+    }
+}
+
+#[test]
+fn weights_scale_the_response_but_not_the_frequency() {
+    let p = scene("paper-2d-top-corners");
+    let r = 4;
+    let j = 2;
+    let mut omegas = Vec::new();
+    for w in [0.5, 1.0, 2.0] {
+        let mut t = Tunables::physical(r);
+        t.mode_weights[j] = w;
+        let mut sim = Simulator::new(&p, &solver(Reduction::Modal, Integrator::NewmarkImplicit, r), &t).unwrap();
+        let omega = sim.mode_frequencies()[j];
+        let mut state = vec![0.0; 3 * r];
+        state[j] = 1e-6;
+        state[2 * r + j] = -omega * omega * 1e-6;
+        let dt = 2.0 * std::f64::consts::PI / omega / 400.0;
+        let samples = oscillate(&mut sim, state, j, dt, 400 * 6);
+        omegas.push((measured_omega(&samples, dt), omega));
+    }
+    for (measured, omega) in &omegas {
+        assert!((measured - omegas[1].0).abs() < 1e-6 * omega, "{omegas:?}");
+    }
+    // Under gravity the static response of a mode scales with its weight.
+    let mut sag = Vec::new();
+    for w in [1.0, 2.0] {
+        let mut t = Tunables::physical(r);
+        t.mode_weights = vec![w; r];
+        t.damping_alpha = 5.0;
+        let mut sim = Simulator::new(&scene("paper-2d-top-row"), &solver(Reduction::Modal, Integrator::NewmarkImplicit, r), &t).unwrap();
+        for _ in 0..400 {
+            sim.do_step(0.01).unwrap();
+        }
+        sag.push(sim.modal_coordinates()[1]);
+    }
+    let ratio = sag[1] / sag[0];
+    assert!(ratio > 1.5 && ratio < 2.5, "doubling the weights scales the sag by {ratio}");
+}
+
+#[test]
+fn explicit_diverges_without_substepping_and_is_stable_with_it() {
+    let p = scene("paper-2d-top-row");
+    let h = 1.0 / 60.0;
+    let mut s = solver(Reduction::Full, Integrator::NewmarkExplicit, 0);
+    s.substepping = false;
+    let mut sim = Simulator::new(&p, &s, &Tunables::physical(0)).unwrap();
+    let before = sim.positions().to_vec();
+    let failed = (0..200).find_map(|_| sim.do_step(h).err());
+    let e = failed.expect("explicit full-space run at dt = 1/60 s must diverge");
+    assert!(e.message.contains("diverged"), "{e}");
+    assert!(sim.positions().iter().all(|v| v.is_finite()));
+    let _ = before;
+
+    s.substepping = true;
+    let mut sim = Simulator::new(&p, &s, &Tunables::physical(0)).unwrap();
+    let mut max_energy = 0.0f64;
+    for _ in 0..120 {
+        sim.do_step(h).unwrap();
+        max_energy = max_energy.max(sim.kinetic_energy());
+    }
+    assert!(sim.internal_steps_last() > 1);
+    assert!(sim.positions().iter().all(|v| v.is_finite()));
+    // kinetic energy stays below what gravity could give the sheet falling its own height
+    assert!(max_energy < 0.9 * 9.81 * 1.0, "kinetic energy {max_energy}");
+}
+
+#[test]
+fn failed_step_keeps_the_last_good_state() {
+    let p = scene("paper-2d-top-row");
+    let mut s = solver(Reduction::Full, Integrator::NewmarkExplicit, 0);
+    s.substepping = false;
+    let mut sim = Simulator::new(&p, &s, &Tunables::physical(0)).unwrap();
+    loop {
+        let snap = sim.snapshot();
+        let pos = sim.positions().to_vec();
+        if sim.do_step(0.05).is_err() {
+            assert_eq!(sim.snapshot(), snap);
+            assert_eq!(sim.positions(), &pos[..]);
+            break;
+        }
+    }
+}
+
+#[test]
+fn snapshot_restore_reproduces_bit_for_bit() {
+    for red in [Reduction::Modal, Reduction::Full] {
+        for integ in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit] {
+            let p = scene("paper-3d-sheet");
+            let s = solver(red, integ, 3);
+            let mut a = Simulator::new(&p, &s, &Tunables::physical(3)).unwrap();
+            for _ in 0..10 {
+                a.do_step(0.01).unwrap();
+            }
+            let snap = a.snapshot();
+            let mut b = Simulator::new(&p, &s, &Tunables::physical(3)).unwrap();
+            b.restore(&snap).unwrap();
+            for _ in 0..10 {
+                a.do_step(0.01).unwrap();
+                b.do_step(0.01).unwrap();
+            }
+            assert_eq!(a.positions(), b.positions());
+            assert_eq!(a.velocities(), b.velocities());
+            assert_eq!(a.time(), b.time());
+        }
+    }
+}
+
+#[test]
+fn gravity_change_changes_motion_and_modal_sags() {
+    let p = scene("paper-2d-top-row");
+    let mut sim = Simulator::new(&p, &SolverParams::default(), &Tunables::physical(2)).unwrap();
+    let y0 = sim.positions()[2 * 95 + 1];
+    for _ in 0..50 {
+        sim.do_step(0.01).unwrap();
+    }
+    assert!(sim.positions()[2 * 95 + 1] < y0 - 1e-3, "bottom row must sag");
+}
