@@ -218,9 +218,9 @@ impl FullSolver {
         let c1 = 2.0 / dt;
         self.explicit_factor = None;
         let mut done = false;
-        let mut result = Err(SimError {
-            message: format!("implicit Newmark: Newton did not converge in {MAX_NEWTON_ITERATIONS} iterations at dt = {dt:e} s; reduce maxInternalStep"),
-        });
+        // Built only on failure: the stepping loop must not allocate.
+        let mut result = Ok(());
+        let mut converged_at_end = false;
         for _ in 0..=MAX_NEWTON_ITERATIONS {
             self.evaluate(scene, &y);
             let (mut v_new, mut a_new) = (std::mem::take(&mut self.v_new), std::mem::take(&mut self.a_new));
@@ -229,7 +229,7 @@ impl FullSolver {
             self.v_new = v_new;
             self.a_new = a_new;
             if done {
-                result = Ok(());
+                converged_at_end = true;
                 break;
             }
             for k in 0..n {
@@ -248,6 +248,11 @@ impl FullSolver {
                 y[k] += delta[k];
             }
             done = converged(&delta, &y, self.length_scale);
+        }
+        if result.is_ok() && !converged_at_end {
+            result = Err(SimError {
+                message: format!("implicit Newmark: Newton did not converge in {MAX_NEWTON_ITERATIONS} iterations at dt = {dt:e} s; reduce maxInternalStep"),
+            });
         }
         if result.is_ok() {
             std::mem::swap(&mut self.u, &mut y);

@@ -160,14 +160,14 @@ impl ModalSolver {
         let c0 = 4.0 / (dt * dt);
         let c1 = 2.0 / dt;
         let mut done = false;
-        let mut result = Err(SimError {
-            message: format!("implicit Newmark: Newton did not converge in {MAX_NEWTON_ITERATIONS} iterations at dt = {dt:e} s; reduce maxInternalStep"),
-        });
+        // Built only on failure: the stepping loop must not allocate.
+        let mut result = Ok(());
+        let mut converged_at_end = false;
         for _ in 0..=MAX_NEWTON_ITERATIONS {
             self.evaluate(scene, &y);
             implicit_kinematics(&self.q, &self.qd, &self.qdd, &y, dt, &mut self.v_new, &mut self.a_new);
             if done {
-                result = Ok(());
+                converged_at_end = true;
                 break;
             }
             for j in 0..r {
@@ -196,6 +196,11 @@ impl ModalSolver {
                 y[j] += delta[j];
             }
             done = converged(delta, &y, self.q_scale);
+        }
+        if result.is_ok() && !converged_at_end {
+            result = Err(SimError {
+                message: format!("implicit Newmark: Newton did not converge in {MAX_NEWTON_ITERATIONS} iterations at dt = {dt:e} s; reduce maxInternalStep"),
+            });
         }
         if result.is_ok() {
             std::mem::swap(&mut self.q, &mut y);

@@ -1,0 +1,49 @@
+//! The stepping loop allocates nothing: a counting global allocator watches
+//! `do_step` for every reduction and integrator once set-up is done.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use modal_mass_spring::physics::*;
+
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(l) }
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        unsafe { System.dealloc(p, l) }
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.realloc(p, l, n) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn do_step_allocates_nothing() {
+    for name in ["paper-2d-top-row", "paper-3d-sheet"] {
+        for reduction in [Reduction::Modal, Reduction::Full] {
+            for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit] {
+                let p = SceneParams::canonical(name).unwrap();
+                let s = SolverParams { reduction, integrator, n_modes: 4, ..SolverParams::default() };
+                let mut t = Tunables::physical(4);
+                t.damping_beta = 1e-3; // exercises the factorised explicit velocity update too
+                let mut sim = Simulator::new(&p, &s, &t).unwrap();
+                sim.do_step(0.01).unwrap(); // first step may factorise
+                let before = ALLOCATIONS.load(Ordering::SeqCst);
+                for _ in 0..20 {
+                    sim.do_step(0.01).unwrap();
+                }
+                let n = ALLOCATIONS.load(Ordering::SeqCst) - before;
+                assert_eq!(n, 0, "{name} {reduction:?} {integrator:?}: {n} allocations in 20 steps");
+            }
+        }
+    }
+}
