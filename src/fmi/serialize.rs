@@ -1,0 +1,198 @@
+//! Byte format of a serialized FMU state (little-endian):
+//!
+//! | bytes | content |
+//! |---|---|
+//! | 8 | magic `MMSFMU3S` |
+//! | 4 | format version |
+//! | 8 | fingerprint of the variable layout |
+//! | 8 | payload length |
+//! | n | payload: mode, start time, every parameter (vr, length, values), simulator snapshot |
+//! | 8 | FNV-1a 64 checksum of everything before |
+//!
+//! Decoding checks all of it and every value against the model description,
+//! so a corrupted or foreign blob is refused instead of loaded.
+
+use super::instance::{check_value, FmuState, Mode};
+use super::model::Params;
+use super::variables::{index_of, LAYOUT_FINGERPRINT, VARIABLES};
+use crate::physics::{Snapshot, Tunables};
+
+const MAGIC: &[u8; 8] = b"MMSFMU3S";
+const VERSION: u32 = 1;
+const HEADER: usize = 8 + 4 + 8 + 8;
+
+pub fn encode(s: &FmuState) -> Vec<u8> {
+    let mut p = Vec::new();
+    p.push(s.mode as u8);
+    put_f64(&mut p, s.start_time);
+    let params: Vec<usize> = (0..VARIABLES.len()).filter(|&i| VARIABLES[i].is_parameter()).collect();
+    put_u64(&mut p, params.len() as u64);
+    for i in params {
+        p.extend_from_slice(&VARIABLES[i].vr.to_le_bytes());
+        put_f64s(&mut p, &s.params.values[i]);
+    }
+    match &s.snapshot {
+        None => p.push(0),
+        Some(snap) => {
+            p.push(1);
+            put_f64(&mut p, snap.time);
+            put_f64s(&mut p, &snap.state);
+            let t = &snap.tunables;
+            t.gravity.iter().for_each(|g| put_f64(&mut p, *g));
+            put_f64(&mut p, t.damping_alpha);
+            put_f64(&mut p, t.damping_beta);
+            put_f64s(&mut p, &t.mode_weights);
+        }
+    }
+    let mut out = Vec::with_capacity(HEADER + p.len() + 8);
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&VERSION.to_le_bytes());
+    out.extend_from_slice(&LAYOUT_FINGERPRINT.to_le_bytes());
+    put_u64(&mut out, p.len() as u64);
+    out.extend_from_slice(&p);
+    let sum = fnv1a(&out);
+    put_u64(&mut out, sum);
+    out
+}
+
+pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
+    if bytes.len() < HEADER + 8 {
+        return Err(format!("{} bytes is too short for a serialized state", bytes.len()));
+    }
+    if &bytes[..8] != MAGIC {
+        return Err("not a serialized state of this FMU (bad magic)".into());
+    }
+    let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
+    if version != VERSION {
+        return Err(format!("serialized state format {version}, this FMU reads {VERSION}"));
+    }
+    let fp = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
+    if fp != LAYOUT_FINGERPRINT {
+        return Err("serialized state of a different model description".into());
+    }
+    let len = u64::from_le_bytes(bytes[20..28].try_into().unwrap());
+    if len != (bytes.len() - HEADER - 8) as u64 {
+        return Err(format!("payload length {len} does not match the {} bytes given", bytes.len()));
+    }
+    let (body, tail) = bytes.split_at(bytes.len() - 8);
+    if fnv1a(body) != u64::from_le_bytes(tail.try_into().unwrap()) {
+        return Err("checksum mismatch: the serialized state is corrupted".into());
+    }
+    let mut r = Reader { b: &body[HEADER..] };
+    let mode = Mode::from_u8(r.u8()?).ok_or("bad mode")?;
+    let start_time = r.f64()?;
+    if !start_time.is_finite() {
+        return Err("start time is not finite".into());
+    }
+    let mut params = Params { values: vec![Vec::new(); VARIABLES.len()] };
+    let n = r.u64()?;
+    let mut seen = vec![false; VARIABLES.len()];
+    for _ in 0..n {
+        let vr = r.u32()?;
+        let i = index_of(vr).filter(|&i| VARIABLES[i].is_parameter()).ok_or(format!("value reference {vr} is not a parameter"))?;
+        if std::mem::replace(&mut seen[i], true) {
+            return Err(format!("{} appears twice", VARIABLES[i].name));
+        }
+        params.values[i] = r.f64s()?;
+    }
+    for (i, v) in VARIABLES.iter().enumerate() {
+        if v.is_parameter() {
+            if !seen[i] {
+                return Err(format!("{} is missing", v.name));
+            }
+            // Array sizes are checked below, once the structural parameters are known.
+            if v.dims.is_empty() && params.values[i].len() != 1 {
+                return Err(format!("{} holds {} values, expected 1", v.name, params.values[i].len()));
+            }
+            for x in &params.values[i] {
+                check_value(v, Some(*x)).map_err(|m| format!("{} = {x}: {m}", v.name))?;
+            }
+        }
+    }
+    for (i, v) in VARIABLES.iter().enumerate() {
+        let want = if v.is_parameter() { params.size_of(v) } else { 0 };
+        if params.values[i].len() != want {
+            return Err(format!("{} holds {} values, expected {want}", v.name, params.values[i].len()));
+        }
+    }
+    let snapshot = match r.u8()? {
+        0 => None,
+        1 => {
+            let time = r.f64()?;
+            let state = r.f64s()?;
+            let gravity = [r.f64()?, r.f64()?, r.f64()?];
+            let damping_alpha = r.f64()?;
+            let damping_beta = r.f64()?;
+            let mode_weights = r.f64s()?;
+            Some(Snapshot { time, state, tunables: Tunables { gravity, damping_alpha, damping_beta, mode_weights } })
+        }
+        _ => return Err("bad snapshot flag".into()),
+    };
+    if !r.b.is_empty() {
+        return Err(format!("{} unexpected bytes at the end", r.b.len()));
+    }
+    if matches!(mode, Mode::StepMode | Mode::Terminated) && snapshot.is_none() {
+        return Err("a state after initialization must hold the simulator state".into());
+    }
+    if let Some(s) = &snapshot {
+        if s.tunables != params.tunables() {
+            return Err("simulator tunables differ from the parameters".into());
+        }
+    }
+    Ok(FmuState::new(mode, start_time, params, snapshot))
+}
+
+fn put_u64(v: &mut Vec<u8>, x: u64) {
+    v.extend_from_slice(&x.to_le_bytes());
+}
+fn put_f64(v: &mut Vec<u8>, x: f64) {
+    v.extend_from_slice(&x.to_le_bytes());
+}
+fn put_f64s(v: &mut Vec<u8>, x: &[f64]) {
+    put_u64(v, x.len() as u64);
+    x.iter().for_each(|x| put_f64(v, *x));
+}
+
+fn fnv1a(b: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &x in b {
+        h ^= x as u64;
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}
+
+struct Reader<'a> {
+    b: &'a [u8],
+}
+
+impl Reader<'_> {
+    fn take(&mut self, n: usize) -> Result<&[u8], String> {
+        if self.b.len() < n {
+            return Err("truncated serialized state".into());
+        }
+        let (a, rest) = self.b.split_at(n);
+        self.b = rest;
+        Ok(a)
+    }
+    fn u8(&mut self) -> Result<u8, String> {
+        Ok(self.take(1)?[0])
+    }
+    fn u32(&mut self) -> Result<u32, String> {
+        Ok(u32::from_le_bytes(self.take(4)?.try_into().unwrap()))
+    }
+    fn u64(&mut self) -> Result<u64, String> {
+        Ok(u64::from_le_bytes(self.take(8)?.try_into().unwrap()))
+    }
+    fn f64(&mut self) -> Result<f64, String> {
+        Ok(f64::from_le_bytes(self.take(8)?.try_into().unwrap()))
+    }
+    /// Length-prefixed; the length is checked against the bytes left before allocating.
+    fn f64s(&mut self) -> Result<Vec<f64>, String> {
+        let n = self.u64()?;
+        if n > (self.b.len() / 8) as u64 {
+            return Err("truncated serialized state".into());
+        }
+        (0..n).map(|_| self.f64()).collect()
+    }
+}
