@@ -1,1 +1,127 @@
-pub fn main(_args: &[String]) -> Result<(), String> { Err("not yet".into()) }
+//! `cargo xtask fmu [--scene NAME] [--nx N] [--ny N] [--modes R] [--out PATH]`
+//!
+//! Builds the cdylib in release mode and packs the FMU: modelDescription.xml
+//! (generated from modelDescription/variables.toml with the chosen start
+//! values), binaries/x86_64-linux/ModalMassSpring.so and documentation/index.html.
+
+#[path = "../../modelDescription/generate.rs"]
+mod generate;
+
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use zip::write::SimpleFileOptions;
+
+const PLATFORM: &str = "x86_64-linux";
+
+struct Options {
+    scene: Option<String>,
+    nx: Option<u64>,
+    ny: Option<u64>,
+    modes: Option<u64>,
+    out: Option<PathBuf>,
+}
+
+fn parse(args: &[String]) -> Result<Options, String> {
+    let mut o = Options { scene: None, nx: None, ny: None, modes: None, out: None };
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        let mut value = || it.next().cloned().ok_or(format!("{a} needs a value"));
+        let number = |v: String| v.parse::<u64>().map_err(|_| format!("{a}: not a non-negative integer: {v}"));
+        match a.as_str() {
+            "--scene" => o.scene = Some(value()?),
+            "--nx" => o.nx = Some(number(value()?)?),
+            "--ny" => o.ny = Some(number(value()?)?),
+            "--modes" => o.modes = Some(number(value()?)?),
+            "--out" => o.out = Some(PathBuf::from(value()?)),
+            "-h" | "--help" => {
+                return Err("usage: cargo xtask fmu [--scene NAME] [--nx N] [--ny N] [--modes R] [--out PATH]".into())
+            }
+            other => return Err(format!("unknown option {other}")),
+        }
+    }
+    Ok(o)
+}
+
+pub fn main(args: &[String]) -> Result<(), String> {
+    let o = parse(args)?;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf();
+    let spec = generate::load(&root.join("modelDescription/variables.toml"))?;
+
+    let mut overrides: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    if let Some(s) = &o.scene {
+        overrides = spec
+            .scene(s)
+            .ok_or(format!("unknown scene {s}; known: {}", spec.scene_names().join(", ")))?;
+    }
+    for (name, v) in [("nx", o.nx), ("ny", o.ny), ("nModes", o.modes)] {
+        if let Some(v) = v {
+            overrides.insert(name.into(), vec![v as f64]);
+        }
+    }
+    let check = |name: &str| -> Result<(), String> {
+        let var = spec.variable(name).unwrap();
+        let x = overrides.get(name).map(|v| v[0]);
+        match (x, var.min, var.max) {
+            (Some(x), Some(lo), _) if x < lo => Err(format!("{name} = {x} is below its minimum {lo}")),
+            (Some(x), _, Some(hi)) if x > hi => Err(format!("{name} = {x} is above its maximum {hi}")),
+            _ => Ok(()),
+        }
+    };
+    for name in ["nx", "ny", "nModes"] {
+        check(name)?;
+    }
+
+    let xml = spec.model_description_xml(&overrides)?;
+    let title = match &o.scene {
+        Some(s) => format!("{} ({s})", spec.model_name),
+        None => spec.model_name.clone(),
+    };
+    let html = spec.documentation_html(&overrides, &title)?;
+
+    let target = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or(root.join("target"));
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let status = Command::new(cargo)
+        .current_dir(&root)
+        .args(["build", "--release", "--lib", "--package", "modal_mass_spring"])
+        .status()
+        .map_err(|e| format!("cannot run cargo: {e}"))?;
+    if !status.success() {
+        return Err("cargo build --release --lib failed".into());
+    }
+    let lib = target.join("release/libmodal_mass_spring.so");
+    let binary = std::fs::read(&lib).map_err(|e| format!("{}: {e}", lib.display()))?;
+
+    let out = o.out.clone().unwrap_or_else(|| {
+        let mut name = o.scene.clone().unwrap_or_else(|| spec.model_identifier.clone());
+        for (tag, v) in [("nx", o.nx), ("ny", o.ny), ("modes", o.modes)] {
+            if let Some(v) = v {
+                name.push_str(&format!("-{tag}{v}"));
+            }
+        }
+        target.join("fmu").join(format!("{name}.fmu"))
+    });
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    // Written next to the target and renamed, so a reader never sees half an FMU.
+    let tmp = out.with_extension("fmu.part");
+    let file = std::fs::File::create(&tmp).map_err(|e| format!("{}: {e}", tmp.display()))?;
+    let mut zip = zip::ZipWriter::new(file);
+    let opts = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
+    let entries: [(String, &[u8]); 3] = [
+        ("modelDescription.xml".into(), xml.as_bytes()),
+        (format!("binaries/{PLATFORM}/{}.so", spec.model_identifier), &binary),
+        ("documentation/index.html".into(), html.as_bytes()),
+    ];
+    for (name, data) in entries {
+        zip.start_file(name.as_str(), opts).map_err(|e| e.to_string())?;
+        zip.write_all(data).map_err(|e| e.to_string())?;
+    }
+    zip.finish().map_err(|e| e.to_string())?;
+    std::fs::rename(&tmp, &out).map_err(|e| format!("{}: {e}", out.display()))?;
+    println!("{}", out.display());
+    Ok(())
+}
