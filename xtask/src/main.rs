@@ -3,9 +3,11 @@
 //! - `fmu`    build the release library and package `target/fmu/ModalMassSpring.fmu`
 //! - `run`    build the FMU and run the main job through fmpy (summary + plot)
 //! - `test`   every test: Rust (cargo test) and Python (pytest + fmpy)
+//! - `report` the error-against-run-time study into `report/` (`--quick`: small, for CI)
 //! - `setup`  install what the other tasks need (libclang, Python venv with fmpy)
 
 mod fmu;
+mod report;
 mod run;
 mod setup;
 
@@ -21,9 +23,10 @@ fn main() -> ExitCode {
         "fmu" => fmu::main(rest),
         "run" => run::run(rest),
         "test" => run::test(rest),
+        "report" => report::main(rest),
         "setup" => setup::main(rest),
         _ => {
-            eprintln!("usage: cargo xtask <fmu|run|test|setup> [options]");
+            eprintln!("usage: cargo xtask <fmu|run|test|report|setup> [options]");
             return ExitCode::from(2);
         }
     };

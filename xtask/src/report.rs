@@ -1,0 +1,39 @@
+//! `cargo xtask report [--quick] [--out DIR]`: runs the error-against-run-time
+//! study (examples/report.rs) in release mode, then draws its plots with the
+//! project's Python environment (`cargo xtask setup` makes it).
+
+use std::path::Path;
+use std::process::Command;
+
+pub fn main(args: &[String]) -> Result<(), String> {
+    let quick = args.iter().any(|a| a == "--quick");
+    let out = args.iter().position(|a| a == "--out").and_then(|i| args.get(i + 1)).cloned().unwrap_or_else(|| "report".into());
+    let date = Command::new("date").arg("-u").arg("+%Y-%m-%d").output().ok().and_then(|o| String::from_utf8(o.stdout).ok()).unwrap_or_default();
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string()))
+        .unwrap_or_else(|| "unknown CPU".into());
+    let mut cmd = Command::new(env!("CARGO"));
+    cmd.args(["run", "--release", "--example", "report", "--", "--out", &out]);
+    if quick {
+        cmd.arg("--quick");
+    }
+    cmd.env("REPORT_DATE", format!("{} on {cpu}", date.trim()));
+    let status = cmd.status().map_err(|e| format!("cannot run cargo: {e}"))?;
+    if !status.success() {
+        return Err("the study failed".into());
+    }
+    let python = Path::new(".venv/bin/python");
+    if !python.exists() {
+        return Err("no .venv: run `cargo xtask setup` first to draw the plots".into());
+    }
+    let status = Command::new(python)
+        .args(["xtask/plot_report.py", &format!("{out}/error_vs_runtime.csv"), &out])
+        .status()
+        .map_err(|e| format!("cannot run python: {e}"))?;
+    if !status.success() {
+        return Err("plotting failed".into());
+    }
+    println!("report written to {out}/");
+    Ok(())
+}
