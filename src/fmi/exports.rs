@@ -11,6 +11,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use fmi_sys::fmi3::*;
 
 use super::instance::{log_raw, mask, slice, Instance, ERROR, FATAL, OK};
+use super::model::Params;
 use super::serialize;
 use super::variables::{index_of, Type, INSTANTIATION_TOKEN, VARIABLES};
 
@@ -97,7 +98,7 @@ const _: fmi3InstantiateModelExchangeTYPE = Some(fmi3InstantiateModelExchange);
 pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
     instanceName: fmi3String,
     instantiationToken: fmi3String,
-    _resourcePath: fmi3String,
+    resourcePath: fmi3String,
     _visible: fmi3Boolean,
     loggingOn: fmi3Boolean,
     eventModeUsed: fmi3Boolean,
@@ -127,7 +128,22 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
             return fail("this FMU provides no intermediate update (providesIntermediateUpdate = false)".into());
         }
         let name = if instanceName.is_null() { String::new() } else { unsafe { CStr::from_ptr(instanceName) }.to_string_lossy().into_owned() };
-        let inst = Instance::new(instanceEnvironment, logMessage, loggingOn);
+        let start = if resourcePath.is_null() {
+            Params::start()
+        } else {
+            let dir = unsafe { CStr::from_ptr(resourcePath) }.to_string_lossy().into_owned();
+            let dir = dir.strip_prefix("file://").unwrap_or(&dir).to_string();
+            let file = std::path::Path::new(&dir).join("startValues.txt");
+            match std::fs::read_to_string(&file) {
+                Ok(text) => match Params::from_text(&text) {
+                    Ok(p) => p,
+                    Err(m) => return fail(format!("{}: {m}", file.display())),
+                },
+                // No file: the compiled start values are those of modelDescription.xml.
+                Err(_) => Params::start(),
+            }
+        };
+        let inst = Instance::new(instanceEnvironment, logMessage, loggingOn, start);
         inst.log(OK, &format!("instance \"{name}\" created"));
         inst.into_raw()
     });

@@ -83,6 +83,8 @@ pub struct Instance {
     /// Set after a panic: the instance may be inconsistent and only accepts FreeInstance.
     pub poisoned: bool,
     pub params: Params,
+    /// Values restored by fmi3Reset: compiled start values or the FMU's resources/startValues.txt.
+    start: Params,
     /// Built lazily; `None` or `stale` means parameters changed since.
     sim: Option<Simulator>,
     stale: bool,
@@ -92,7 +94,7 @@ pub struct Instance {
 type R = Result<fmi3Status, fmi3Status>;
 
 impl Instance {
-    pub fn new(env: fmi3InstanceEnvironment, logger: fmi3LogMessageCallback, logging_on: bool) -> Self {
+    pub fn new(env: fmi3InstanceEnvironment, logger: fmi3LogMessageCallback, logging_on: bool, start: Params) -> Self {
         Instance {
             magic: INSTANCE_MAGIC,
             env,
@@ -101,7 +103,8 @@ impl Instance {
             categories: vec![true; LOG_CATEGORIES.len()],
             mode: Mode::Instantiated,
             poisoned: false,
-            params: Params::start(),
+            params: start.clone(),
+            start,
             sim: None,
             stale: true,
             start_time: 0.0,
@@ -274,7 +277,7 @@ impl Instance {
 
     pub fn reset(&mut self) -> R {
         self.mode = Mode::Instantiated;
-        self.params = Params::start();
+        self.params = self.start.clone();
         self.sim = None;
         self.stale = true;
         self.start_time = 0.0;

@@ -20,6 +20,43 @@ impl Params {
         p
     }
 
+    /// Start values from `resources/startValues.txt` (`name value...` per
+    /// line, written by `cargo xtask fmu`); parameters not listed keep their
+    /// compiled start value. Every value is range-checked.
+    pub fn from_text(text: &str) -> Result<Self, String> {
+        let mut p = Params::start();
+        for line in text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')) {
+            let mut words = line.split_whitespace();
+            let name = words.next().unwrap();
+            let i = VARIABLES
+                .iter()
+                .position(|v| v.name == name && v.is_parameter())
+                .ok_or(format!("{name} is not a parameter"))?;
+            let values = words
+                .map(|w| w.parse::<f64>().map_err(|_| format!("{name}: {w} is not a number")))
+                .collect::<Result<Vec<_>, _>>()?;
+            for x in &values {
+                super::instance::check_value(&VARIABLES[i], Some(*x)).map_err(|m| format!("{name} = {x}: {m}"))?;
+            }
+            p.values[i] = values;
+        }
+        for (i, v) in VARIABLES.iter().enumerate().filter(|(_, v)| v.is_parameter() && v.dims.is_empty()) {
+            if p.values[i].len() != 1 {
+                return Err(format!("{} needs one value", v.name));
+            }
+        }
+        for (i, v) in VARIABLES.iter().enumerate().filter(|(_, v)| v.is_parameter() && !v.dims.is_empty()) {
+            if p.values[i].len() != p.size_of(v) {
+                if v.dims.iter().any(|d| matches!(d, Dim::Param(_))) && !text.lines().any(|l| l.split_whitespace().next() == Some(v.name)) {
+                    continue; // fitted below
+                }
+                return Err(format!("{} needs {} values, got {}", v.name, p.size_of(v), p.values[i].len()));
+            }
+        }
+        p.fit_arrays();
+        Ok(p)
+    }
+
     pub fn get(&self, vr: u32) -> &[f64] {
         &self.values[index_of(vr).expect("known value reference")]
     }

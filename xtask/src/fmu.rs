@@ -2,7 +2,8 @@
 //!
 //! Builds the cdylib in release mode and packs the FMU: modelDescription.xml
 //! (generated from modelDescription/variables.toml with the chosen start
-//! values), binaries/x86_64-linux/ModalMassSpring.so and documentation/index.html.
+//! values), binaries/x86_64-linux/ModalMassSpring.so, documentation/index.html
+//! and resources/startValues.txt (the same start values, read by the binary).
 
 #[path = "../../modelDescription/generate.rs"]
 mod generate;
@@ -80,6 +81,7 @@ pub fn main(args: &[String]) -> Result<(), String> {
         None => spec.model_name.clone(),
     };
     let html = spec.documentation_html(&overrides, &title)?;
+    let starts = spec.start_values_text(&overrides)?;
 
     let target = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or(root.join("target"));
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
@@ -111,10 +113,11 @@ pub fn main(args: &[String]) -> Result<(), String> {
     let file = std::fs::File::create(&tmp).map_err(|e| format!("{}: {e}", tmp.display()))?;
     let mut zip = zip::ZipWriter::new(file);
     let opts = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
-    let entries: [(String, &[u8]); 3] = [
+    let entries: [(String, &[u8]); 4] = [
         ("modelDescription.xml".into(), xml.as_bytes()),
         (format!("binaries/{PLATFORM}/{}.so", spec.model_identifier), &binary),
         ("documentation/index.html".into(), html.as_bytes()),
+        ("resources/startValues.txt".into(), starts.as_bytes()),
     ];
     for (name, data) in entries {
         zip.start_file(name.as_str(), opts).map_err(|e| e.to_string())?;
