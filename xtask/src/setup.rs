@@ -1,1 +1,148 @@
-pub fn main(_args: &[String]) -> Result<(), String> { Err("not yet".into()) }
+//! `cargo xtask setup`: installs what the other tasks need, and only what is
+//! missing, so it is cheap to run again.
+//!
+//! - Debian packages: `libclang-dev` (bindgen in `fmi-sys`) and `libxml2-dev`
+//!   (XSD validation in `fmi-rs`), through apt-get (`apt-get update` once,
+//!   only when something has to be installed).
+//! - The Python environment `.venv` in the repository root, with fmpy, pytest,
+//!   numpy and matplotlib.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+/// Debian packages the Rust build and tests need.
+const DEBIAN_PACKAGES: &[&str] = &["libclang-dev", "libxml2-dev"];
+
+/// Python packages: (distribution name as pip knows it, requirement to install).
+const PYTHON_PACKAGES: &[(&str, &str)] = &[
+    ("fmpy", "fmpy==0.3.32"),
+    ("pytest", "pytest"),
+    ("numpy", "numpy"),
+    ("matplotlib", "matplotlib"),
+];
+
+/// The version of fmpy the tests are written against.
+const FMPY_VERSION: &str = "0.3.32";
+
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
+}
+
+/// The venv's Python interpreter.
+pub fn python() -> PathBuf {
+    root().join(".venv/bin/python")
+}
+
+pub fn main(args: &[String]) -> Result<(), String> {
+    if let Some(a) = args.first() {
+        return Err(format!("unknown option {a}; usage: cargo xtask setup"));
+    }
+    debian_packages()?;
+    venv()?;
+    python_packages()?;
+    Ok(())
+}
+
+fn debian_installed(pkg: &str) -> bool {
+    Command::new("dpkg-query")
+        .args(["-W", "-f=${Status}", pkg])
+        .stderr(Stdio::null())
+        .output()
+        .map(|o| o.status.success() && String::from_utf8_lossy(&o.stdout).contains("install ok installed"))
+        .unwrap_or(false)
+}
+
+fn is_root() -> bool {
+    Command::new("id")
+        .arg("-u")
+        .output()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
+        .unwrap_or(false)
+}
+
+fn debian_packages() -> Result<(), String> {
+    let missing: Vec<&str> = DEBIAN_PACKAGES.iter().copied().filter(|p| !debian_installed(p)).collect();
+    if missing.is_empty() {
+        return Ok(());
+    }
+    if Command::new("apt-get").arg("--version").stdout(Stdio::null()).status().is_err() {
+        return Err(format!("missing system packages {} and no apt-get to install them", missing.join(" ")));
+    }
+    eprintln!("setup: installing {} with apt-get", missing.join(" "));
+    // As root apt-get runs directly; otherwise through sudo (non-interactive).
+    let apt = |args: &[&str]| -> Result<(), String> {
+        let mut cmd = if is_root() {
+            Command::new("apt-get")
+        } else {
+            let mut c = Command::new("sudo");
+            c.args(["-n", "apt-get"]);
+            c
+        };
+        cmd.args(args).env("DEBIAN_FRONTEND", "noninteractive");
+        let status = cmd.status().map_err(|e| format!("cannot run apt-get: {e}"))?;
+        if status.success() {
+            Ok(())
+        } else {
+            Err(format!("apt-get {} failed ({status})", args.join(" ")))
+        }
+    };
+    apt(&["update", "-q"])?;
+    let mut install = vec!["install", "-y", "-q", "--no-install-recommends"];
+    install.extend(&missing);
+    apt(&install)?;
+    Ok(())
+}
+
+fn venv() -> Result<(), String> {
+    let py = python();
+    if py.exists() && Command::new(&py).args(["-m", "pip", "--version"]).stdout(Stdio::null()).status().map(|s| s.success()).unwrap_or(false) {
+        return Ok(());
+    }
+    let dir = root().join(".venv");
+    eprintln!("setup: creating {}", dir.display());
+    let status = Command::new("python3")
+        .args(["-m", "venv", "--clear"])
+        .arg(&dir)
+        .status()
+        .map_err(|e| format!("cannot run python3 (Python 3 is needed): {e}"))?;
+    if !status.success() {
+        return Err(format!(
+            "python3 -m venv {} failed; on Debian the venv module is in the package python3-venv",
+            dir.display()
+        ));
+    }
+    Ok(())
+}
+
+/// Installed version of each distribution, as the venv's Python sees it.
+fn installed_version(dist: &str) -> Option<String> {
+    let code = format!(
+        "import importlib.metadata as m\ntry:\n    print(m.version({dist:?}))\nexcept m.PackageNotFoundError:\n    pass\n"
+    );
+    let out = Command::new(python()).args(["-c", &code]).output().ok()?;
+    let v = String::from_utf8_lossy(&out.stdout).trim().to_string();
+    (out.status.success() && !v.is_empty()).then_some(v)
+}
+
+fn python_packages() -> Result<(), String> {
+    let mut missing = Vec::new();
+    for (dist, req) in PYTHON_PACKAGES {
+        match installed_version(dist) {
+            Some(v) if *dist != "fmpy" || v == FMPY_VERSION => {}
+            _ => missing.push(*req),
+        }
+    }
+    if missing.is_empty() {
+        return Ok(());
+    }
+    eprintln!("setup: pip install {}", missing.join(" "));
+    let status = Command::new(python())
+        .args(["-m", "pip", "install", "--disable-pip-version-check", "-q"])
+        .args(&missing)
+        .status()
+        .map_err(|e| format!("cannot run pip: {e}"))?;
+    if !status.success() {
+        return Err(format!("pip install {} failed", missing.join(" ")));
+    }
+    Ok(())
+}

@@ -1,0 +1,144 @@
+"""Point 4 of the issue from Python: fmpy validates every FMU with no problem,
+and the model description carries the public interface with its fixed names."""
+
+import subprocess
+import sys
+import zipfile
+
+import pytest
+from fmpy import read_model_description
+from fmpy.validation import validate_fmu
+
+# name -> (type, causality, variability) of the public interface
+INTERFACE = {
+    "time": ("Float64", "independent", "continuous"),
+    "nx": ("UInt64", "structuralParameter", "fixed"),
+    "ny": ("UInt64", "structuralParameter", "fixed"),
+    "dimension": ("UInt64", "structuralParameter", "fixed"),
+    "nModes": ("UInt64", "structuralParameter", "fixed"),
+    "spacing": ("Float64", "parameter", "fixed"),
+    "nodeMass": ("Float64", "parameter", "fixed"),
+    "springStiffness": ("Float64", "parameter", "fixed"),
+    "shearSprings": ("Boolean", "parameter", "fixed"),
+    "bendingSprings": ("Boolean", "parameter", "fixed"),
+    "auxStiffness": ("Float64", "parameter", "fixed"),
+    "maxInternalStep": ("Float64", "parameter", "fixed"),
+    "fixedNodes": ("Enumeration", "parameter", "fixed"),
+    "reduction": ("Enumeration", "parameter", "fixed"),
+    "integrator": ("Enumeration", "parameter", "fixed"),
+    "gravity": ("Float64", "parameter", "tunable"),
+    "dampingAlpha": ("Float64", "parameter", "tunable"),
+    "dampingBeta": ("Float64", "parameter", "tunable"),
+    "modeWeights": ("Float64", "parameter", "tunable"),
+    "positions": ("Float64", "output", "continuous"),
+    "velocities": ("Float64", "output", "continuous"),
+    "modalCoordinates": ("Float64", "output", "continuous"),
+    "kineticEnergy": ("Float64", "output", "continuous"),
+    "potentialEnergy": ("Float64", "output", "continuous"),
+    "modeFrequencies": ("Float64", "calculatedParameter", "fixed"),
+}
+
+ENUMERATIONS = {
+    "fixedNodes": ["top-row", "top-corners"],
+    "reduction": ["modal", "full"],
+    "integrator": ["newmark-explicit", "newmark-implicit"],
+}
+
+# array variables and the structural parameters (or fixed sizes) of their dimensions
+DIMENSIONS = {
+    "gravity": [3],
+    "modeWeights": ["nModes"],
+    "positions": ["ny", "nx", "dimension"],
+    "velocities": ["ny", "nx", "dimension"],
+    "modalCoordinates": ["nModes"],
+    "modeFrequencies": ["nModes"],
+}
+
+
+def test_validate_fmu_reports_no_problem(any_fmu):
+    assert validate_fmu(any_fmu) == []
+
+
+def test_fmpy_validate_command(any_fmu):
+    """The command line `fmpy validate` (exit code = number of problems)."""
+    r = subprocess.run([sys.executable, "-m", "fmpy", "validate", any_fmu], capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "No problems found." in r.stdout
+
+
+def test_archive_layout(any_fmu):
+    names = set(zipfile.ZipFile(any_fmu).namelist())
+    assert "modelDescription.xml" in names
+    assert "binaries/x86_64-linux/ModalMassSpring.so" in names
+    assert any(n.startswith("documentation/") for n in names)
+
+
+def test_interface(any_fmu):
+    md = read_model_description(any_fmu)
+    assert md.fmiVersion == "3.0"
+    assert md.modelName == "ModalMassSpring"
+    assert md.coSimulation is not None and md.modelExchange is None and md.scheduledExecution is None
+    cs = md.coSimulation
+    assert cs.modelIdentifier == "ModalMassSpring"
+    assert cs.canGetAndSetFMUstate and cs.canSerializeFMUstate
+    assert cs.canHandleVariableCommunicationStepSize
+    assert md.defaultExperiment.startTime in ("0", "0.0", 0, 0.0, None) or float(md.defaultExperiment.startTime) == 0
+    assert float(md.defaultExperiment.stopTime) == 2
+    assert float(md.defaultExperiment.stepSize) == 0.01
+
+    variables = {v.name: v for v in md.modelVariables}
+    assert set(variables) == set(INTERFACE)
+    for name, (ty, causality, variability) in INTERFACE.items():
+        v = variables[name]
+        assert (v.type, v.causality, v.variability) == (ty, causality, variability), name
+        assert v.description, f"{name} has no description"
+    vrs = [v.valueReference for v in md.modelVariables]
+    assert len(set(vrs)) == len(vrs)
+
+    for name, dims in DIMENSIONS.items():
+        got = [d.variable.name if d.variable is not None else int(d.start) for d in variables[name].dimensions]
+        assert got == dims, name
+
+    types = {t.name: t for t in md.typeDefinitions}
+    for name, items in ENUMERATIONS.items():
+        t = variables[name].declaredType
+        assert t is not None and t.type == "Enumeration", name
+        assert [i.name for i in t.items] == items, name
+        assert [int(i.value) for i in t.items] == [1, 2], name
+        assert t.name in types
+
+    units = {
+        "time": "s", "spacing": "m", "nodeMass": "kg", "springStiffness": "N/m", "auxStiffness": "N/m",
+        "maxInternalStep": "s", "gravity": "m/s2", "dampingAlpha": "1/s", "dampingBeta": "s",
+        "positions": "m", "velocities": "m/s", "kineticEnergy": "J", "potentialEnergy": "J",
+        "modeFrequencies": "rad/s",
+    }
+    defined = {u.name for u in md.unitDefinitions}
+    for name, unit in units.items():
+        v = variables[name]
+        got = v.unit or (v.declaredType.unit if v.declaredType is not None else None)
+        assert got == unit, name
+        assert unit in defined
+
+
+def test_default_start_values(default_fmu):
+    """The default FMU is the paper's Fig. 7 set-up: paper-2d-top-row, 2 modes,
+    explicit Newmark, no damping."""
+    md = read_model_description(default_fmu)
+    s = {v.name: v.start for v in md.modelVariables}
+    assert (int(s["nx"]), int(s["ny"]), int(s["dimension"]), int(s["nModes"])) == (10, 10, 2, 2)
+    assert int(s["fixedNodes"]) == 1 and int(s["reduction"]) == 1 and int(s["integrator"]) == 1
+    assert float(s["dampingAlpha"]) == 0 and float(s["dampingBeta"]) == 0
+    assert [float(x) for x in s["gravity"].split()] == [0.0, -9.81, 0.0]
+    assert [float(x) for x in s["modeWeights"].split()] == [1.0, 1.0]
+
+
+def test_scene_fmu_start_values(scene_fmu):
+    """A scene-baked FMU's array start values match its structural parameters,
+    so plain simulate_fmu needs nothing set."""
+    _, path = scene_fmu
+    md = read_model_description(path)
+    v = {x.name: x for x in md.modelVariables}
+    n_modes = int(v["nModes"].start)
+    assert len(v["modeWeights"].start.split()) == n_modes
+    assert v["positions"].shape == (int(v["ny"].start), int(v["nx"].start), int(v["dimension"].start))
