@@ -68,7 +68,13 @@ fn debian_packages() -> Result<(), String> {
     if Command::new("apt-get").arg("--version").stdout(Stdio::null()).status().is_err() {
         return Err(format!("missing system packages {} and no apt-get to install them", missing.join(" ")));
     }
-    eprintln!("setup: installing {} with apt-get", missing.join(" "));
+    install_debian(&missing)
+}
+
+/// `apt-get update` (once per run of the task) and `apt-get install` of `packages`.
+fn install_debian(packages: &[&str]) -> Result<(), String> {
+    static UPDATED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+    eprintln!("setup: installing {} with apt-get", packages.join(" "));
     // As root apt-get runs directly; otherwise through sudo (non-interactive).
     let apt = |args: &[&str]| -> Result<(), String> {
         let mut cmd = if is_root() {
@@ -86,9 +92,11 @@ fn debian_packages() -> Result<(), String> {
             Err(format!("apt-get {} failed ({status})", args.join(" ")))
         }
     };
-    apt(&["update", "-q"])?;
+    if !UPDATED.swap(true, std::sync::atomic::Ordering::SeqCst) {
+        apt(&["update", "-q"])?;
+    }
     let mut install = vec!["install", "-y", "-q", "--no-install-recommends"];
-    install.extend(&missing);
+    install.extend(packages);
     apt(&install)?;
     Ok(())
 }
@@ -100,18 +108,25 @@ fn venv() -> Result<(), String> {
     }
     let dir = root().join(".venv");
     eprintln!("setup: creating {}", dir.display());
-    let status = Command::new("python3")
-        .args(["-m", "venv", "--clear"])
-        .arg(&dir)
-        .status()
-        .map_err(|e| format!("cannot run python3 (Python 3 is needed): {e}"))?;
-    if !status.success() {
-        return Err(format!(
-            "python3 -m venv {} failed; on Debian the venv module is in the package python3-venv",
-            dir.display()
-        ));
+    let make = || -> Result<bool, String> {
+        Command::new("python3")
+            .args(["-m", "venv", "--clear"])
+            .arg(&dir)
+            .status()
+            .map(|s| s.success())
+            .map_err(|e| format!("cannot run python3 (Python 3 is needed): {e}"))
+    };
+    if make()? {
+        return Ok(());
     }
-    Ok(())
+    // Debian's own python3 keeps venv and ensurepip in the package python3-venv.
+    if Command::new("apt-get").arg("--version").stdout(Stdio::null()).status().is_ok() && !debian_installed("python3-venv") {
+        install_debian(&["python3-venv"])?;
+        if make()? {
+            return Ok(());
+        }
+    }
+    Err(format!("python3 -m venv {} failed; on Debian the venv module is in the package python3-venv", dir.display()))
 }
 
 /// Installed version of each distribution, as the venv's Python sees it.
