@@ -49,6 +49,8 @@ pub struct LogCategory {
 #[serde(deny_unknown_fields)]
 pub struct Unit {
     pub name: String,
+    /// Also the name of the Float64Type that carries the unit.
+    pub quantity: String,
     pub base: BTreeMap<String, i32>,
 }
 
@@ -163,6 +165,9 @@ impl Spec {
             }
             if !CAUSALITIES.contains(&v.causality.as_str()) {
                 return Err(format!("{}: unknown causality {}", v.name, v.causality));
+            }
+            if v.unit.is_some() && (v.ty != "Float64" || v.declared_type.is_some()) {
+                return Err(format!("{}: only Float64 variables without declared_type may have a unit", v.name));
             }
             if v.ty == "Enumeration" {
                 let t = v.declared_type.as_deref().ok_or(format!("{}: enumeration needs declared_type", v.name))?;
@@ -282,6 +287,14 @@ impl Spec {
             w.push_str("/></Unit>\n");
         }
         w.push_str("  </UnitDefinitions>\n  <TypeDefinitions>\n");
+        for u in &self.units {
+            let _ = writeln!(
+                w,
+                "    <Float64Type name=\"{q}\" quantity=\"{q}\" unit=\"{}\"/>",
+                esc(&u.name),
+                q = esc(&u.quantity)
+            );
+        }
         for e in &self.enumerations {
             let _ = writeln!(w, "    <EnumerationType name=\"{}\" description=\"{}\">", esc(&e.name), esc(&e.description));
             for i in &e.items {
@@ -320,7 +333,8 @@ impl Spec {
                 let _ = write!(w, " declaredType=\"{}\"", esc(t));
             }
             if let Some(u) = &v.unit {
-                let _ = write!(w, " unit=\"{}\"", esc(u));
+                let t = &self.units.iter().find(|x| &x.name == u).unwrap().quantity;
+                let _ = write!(w, " declaredType=\"{}\"", esc(t));
             }
             if let Some(m) = v.min {
                 let _ = write!(w, " min=\"{}\"", number(&v.ty, m));
