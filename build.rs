@@ -13,6 +13,14 @@ fn main() {
         println!("cargo:rerun-if-changed={f}");
     }
 
+    // fmi-rs's schema support links libxml2 statically; a system libxml2.a
+    // (see modelDescription/xsd-test.sh) also needs these.
+    if std::env::var_os("CARGO_FEATURE_XSD").is_some() {
+        for lib in ["icuuc", "z", "lzma"] {
+            println!("cargo:rustc-link-arg-tests=-l{lib}");
+        }
+    }
+
     let spec = generate::load(&root.join("modelDescription/variables.toml")).unwrap_or_else(|e| panic!("{e}"));
     // Fail the build, not the importer, if the defaults do not form a valid description.
     spec.model_description_xml(&Default::default()).unwrap_or_else(|e| panic!("{e}"));

@@ -66,6 +66,19 @@ fn validates_with_fmi_rs() {
     }
 }
 
+/// XSD validation (fmi-rs `schema` feature): `cargo test --features xsd`,
+/// or modelDescription/xsd-test.sh where GitHub cannot be reached.
+#[cfg(feature = "xsd")]
+#[test]
+fn validates_against_the_fmi3_xsd() {
+    for (name, xml) in descriptions() {
+        let problems = fmi_rs::schema::validate_fmi3_model_description(xml.as_bytes());
+        assert!(problems.is_empty(), "{name}: {problems:#?}");
+    }
+    let broken = spec().model_description_xml(&BTreeMap::new()).unwrap().replacen("causality=\"output\"", "causality=\"outlet\"", 1);
+    assert!(!fmi_rs::schema::validate_fmi3_model_description(broken.as_bytes()).is_empty());
+}
+
 #[test]
 fn validation_catches_a_broken_description() {
     // The checks above must be able to fail: a duplicate value reference.
