@@ -10,6 +10,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::time::Instant;
 
 use crate::{fmu, setup};
 
@@ -70,14 +71,22 @@ pub fn run(args: &[String]) -> Result<(), String> {
 
 pub fn test(args: &[String]) -> Result<(), String> {
     let root = setup::root();
+    let mut times: Vec<(&str, f64)> = Vec::new();
+    let mut clock = Instant::now();
+    let mut lap = |name: &'static str, times: &mut Vec<(&str, f64)>| {
+        times.push((name, clock.elapsed().as_secs_f64()));
+        clock = Instant::now();
+    };
     step("setup");
     setup::main(&[])?;
+    lap("setup", &mut times);
 
     step("cargo xtask fmu (default and every canonical scene)");
     fmu::main(&[])?;
     for scene in scene_names(&root)? {
         fmu::main(&["--scene".to_string(), scene])?;
     }
+    lap("FMUs", &mut times);
 
     let mut failures = Vec::new();
 
@@ -90,6 +99,7 @@ pub fn test(args: &[String]) -> Result<(), String> {
     if !status.success() {
         failures.push(format!("cargo test ({status})"));
     }
+    lap("cargo test", &mut times);
 
     step("pytest tests/python");
     let status = Command::new(setup::python())
@@ -108,6 +118,9 @@ pub fn test(args: &[String]) -> Result<(), String> {
         Some(c) => failures.push(format!("pytest did not complete (exit code {c})")),
         None => failures.push(format!("pytest was killed ({status})")),
     }
+    lap("pytest", &mut times);
+    let summary: Vec<String> = times.iter().map(|(n, t)| format!("{n} {t:.0} s")).collect();
+    eprintln!("\ntimes: {}", summary.join(", "));
 
     if failures.is_empty() {
         eprintln!("\nall tests passed (cargo test and pytest)");
