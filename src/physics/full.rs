@@ -13,7 +13,7 @@ use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, Symbol
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
-use super::forces::{add_spring_forces, StiffnessPattern};
+use super::forces::{SpringForces, StiffnessPattern};
 use super::newmark::*;
 use super::params::Tunables;
 use super::scene::Scene;
@@ -35,6 +35,7 @@ pub struct FullSolver {
     /// Slot positions of the last force evaluation.
     pub x: Vec<f64>,
     pub elastic: f64,
+    spring_forces: SpringForces,
     h: Vec<f64>,
     y_new: Vec<f64>,
     v_new: Vec<f64>,
@@ -72,6 +73,7 @@ impl FullSolver {
             gravity_force: vec![0.0; n],
             x: scene.rest.clone(),
             elastic: 0.0,
+            spring_forces: SpringForces::new(scene),
             h: vec![0.0; n],
             y_new: vec![0.0; n],
             v_new: vec![0.0; n],
@@ -122,7 +124,7 @@ impl FullSolver {
             self.x[k] = scene.rest[k] + u[k];
         }
         self.h.copy_from_slice(&self.gravity_force);
-        self.elastic = add_spring_forces(scene, &self.x, &mut self.h);
+        self.elastic = self.spring_forces.add_to(scene, &self.x, &mut self.h);
     }
 
     /// cv = C v = alpha M v + beta K0 v.

@@ -2,7 +2,7 @@
 //! full-space Newmark integrators. Knows nothing of FMI.
 //!
 //! Pipeline of one modal force evaluation: `expand` (q -> x) ->
-//! `add_spring_forces` (exact spring forces in physical space, paper eq. 1)
+//! `SpringForces` (exact spring forces in physical space, paper eq. 1)
 //! -> `project` (F = Phi^T f) -> Newmark update in the reduced space.
 
 pub mod forces;

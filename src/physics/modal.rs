@@ -1,7 +1,7 @@
 //! Modal solver: the paper's method.
 //!
 //! State: modal coordinates q (r of them) with x = x* + Phi q. Each force
-//! evaluation runs the pipeline `expand` (q -> x) -> `add_spring_forces`
+//! evaluation runs the pipeline `expand` (q -> x) -> `SpringForces`
 //! (exact, in physical space) -> `project` (Phi^T f). With weights w and
 //! F = Phi^T (f_springs + M g), the mode equations are
 //!   q_i'' + c_i q_i' = h_i(q) = w_i F_i + (w_i - 1) lambda_i q_i,
@@ -12,7 +12,7 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::{factor::lu_in_place, factor::lu_in_place_scratch, solve::solve_in_place_scratch, solve::solve_in_place_with_conj};
 use faer::{Conj, Mat, Par};
 
-use super::forces::{add_reduced_tangent, add_spring_forces};
+use super::forces::{add_reduced_tangent, SpringForces};
 use super::modes::ModalBasis;
 use super::newmark::*;
 use super::params::Tunables;
@@ -34,6 +34,9 @@ pub struct ModalSolver {
     pub x: Vec<f64>,
     /// Elastic energy at `x`.
     pub elastic: f64,
+    spring_forces: SpringForces,
+    /// Phi column-major (each mode contiguous), for the expand and project loops.
+    phi_cols: Vec<f64>,
     f: Vec<f64>,
     h: Vec<f64>,
     q_new: Vec<f64>,
@@ -66,6 +69,8 @@ impl ModalSolver {
             gravity_modal: vec![0.0; r],
             x: scene.rest.clone(),
             elastic: 0.0,
+            spring_forces: SpringForces::new(scene),
+            phi_cols: (0..r).flat_map(|j| (0..n).map(move |k| (k, j))).map(|(k, j)| basis.phi[k * r + j]).collect(),
             f: vec![0.0; n],
             h: vec![0.0; r],
             q_new: vec![0.0; r],
@@ -114,27 +119,23 @@ impl ModalSolver {
 
     /// h(q) into `self.h`, positions into `self.x`, elastic energy into `self.elastic`.
     fn evaluate(&mut self, scene: &Scene, q: &[f64]) {
-        let (n, r) = (self.basis.n, self.basis.r);
-        let phi = &self.basis.phi;
-        // expand: x = x* + Phi q over the free DOFs
-        for k in 0..n {
-            let row = &phi[k * r..(k + 1) * r];
-            self.x[k] = scene.rest[k] + row.iter().zip(q).map(|(p, qj)| p * qj).sum::<f64>();
+        let n = self.basis.n;
+        // expand: x = x* + Phi q over the free DOFs, one mode at a time
+        self.x[..n].copy_from_slice(&scene.rest[..n]);
+        for (col, qj) in self.phi_cols.chunks_exact(n).zip(q) {
+            for (xk, p) in self.x[..n].iter_mut().zip(col) {
+                *xk += p * qj;
+            }
         }
         // exact spring forces in physical space
         self.f.fill(0.0);
-        self.elastic = add_spring_forces(scene, &self.x, &mut self.f);
-        // project: F = Phi^T f
-        self.h.copy_from_slice(&self.gravity_modal);
-        for k in 0..n {
-            let fk = self.f[k];
-            let row = &phi[k * r..(k + 1) * r];
-            for (hj, p) in self.h.iter_mut().zip(row) {
-                *hj += p * fk;
-            }
+        self.elastic = self.spring_forces.add_to(scene, &self.x, &mut self.f);
+        // project: F = Phi^T (f + M g)
+        for ((hj, col), gj) in self.h.iter_mut().zip(self.phi_cols.chunks_exact(n)).zip(&self.gravity_modal) {
+            *hj = gj + col.iter().zip(&self.f).map(|(p, fk)| p * fk).sum::<f64>();
         }
         // weights act on everything but the mode's own linear spring
-        for j in 0..r {
+        for j in 0..self.basis.r {
             self.h[j] = self.w[j] * self.h[j] + (self.w[j] - 1.0) * self.basis.lambda[j] * q[j];
         }
     }
@@ -213,10 +214,22 @@ impl ModalSolver {
 
     /// Velocities of the free DOFs, Phi q'.
     pub fn dof_velocities(&self, out: &mut [f64]) {
-        let r = self.basis.r;
-        for (k, o) in out.iter_mut().enumerate() {
-            *o = self.basis.phi[k * r..(k + 1) * r].iter().zip(&self.qd).map(|(p, v)| p * v).sum();
+        out.fill(0.0);
+        for (col, vj) in self.phi_cols.chunks_exact(self.basis.n).zip(&self.qd) {
+            for (o, p) in out.iter_mut().zip(col) {
+                *o += p * vj;
+            }
         }
+    }
+
+    /// Kinetic energy 1/2 v^T M v = 1/2 |q'|^2, since Phi^T M Phi = I.
+    pub fn kinetic_energy(&self) -> f64 {
+        0.5 * self.qd.iter().map(|v| v * v).sum::<f64>()
+    }
+
+    /// Potential of gravity -(M g)^T u = -(Phi^T M g)^T q, relative to x*.
+    pub fn gravity_potential(&self) -> f64 {
+        -self.gravity_modal.iter().zip(&self.q).map(|(g, q)| g * q).sum::<f64>()
     }
 
     /// Brings `x` and `elastic` in line with the current q (after a restore).

@@ -228,16 +228,11 @@ impl Simulator {
         Ok(())
     }
 
-    fn kinetic_now(&mut self) -> f64 {
-        let mass = &self.scene.dof_mass;
-        let v: &[f64] = match &self.model {
-            Model::Modal(m) => {
-                m.dof_velocities(&mut self.dof_velocities);
-                &self.dof_velocities
-            }
-            Model::Full(f) => &f.v,
-        };
-        0.5 * v.iter().zip(mass).map(|(v, m)| m * v * v).sum::<f64>()
+    fn kinetic_now(&self) -> f64 {
+        match &self.model {
+            Model::Modal(m) => m.kinetic_energy(),
+            Model::Full(f) => 0.5 * f.v.iter().zip(&self.scene.dof_mass).map(|(v, m)| m * v * v).sum::<f64>(),
+        }
     }
 
     fn save_backup(&mut self) {
@@ -284,30 +279,30 @@ impl Simulator {
     /// Positions, velocities, modal coordinates and energies from the state.
     fn refresh_outputs(&mut self) {
         let d = self.scene.dim;
-        let n = self.scene.n_dofs();
         self.kinetic = self.kinetic_now();
-        let (x, elastic) = match &self.model {
-            Model::Modal(m) => (&m.x, m.elastic),
+        let (x, elastic, gravity_potential) = match &self.model {
+            Model::Modal(m) => {
+                m.dof_velocities(&mut self.dof_velocities);
+                self.modal_coordinates.copy_from_slice(&m.q);
+                (&m.x, m.elastic, m.gravity_potential())
+            }
             Model::Full(f) => {
                 self.dof_velocities.copy_from_slice(&f.v);
-                (&f.x, f.elastic)
+                if let Some(b) = &self.reported_basis {
+                    b.project_displacement(&self.scene.dof_mass, &f.u, &mut self.modal_coordinates);
+                }
+                let g = &self.tunables.gravity;
+                let work: f64 = f.u.chunks_exact(d).zip(self.scene.dof_mass.chunks_exact(d)).map(|(u, m)| (0..d).map(|i| m[i] * g[i] * u[i]).sum::<f64>()).sum();
+                (&f.x, f.elastic, -work)
             }
         };
-        for node in 0..self.scene.n_nodes {
-            let slot = self.scene.slot_of_node[node];
-            self.positions[node * d..(node + 1) * d].copy_from_slice(&x[slot * d..(slot + 1) * d]);
-            if slot < self.scene.n_free {
-                self.velocities[node * d..(node + 1) * d].copy_from_slice(&self.dof_velocities[slot * d..(slot + 1) * d]);
-            }
+        let nf = self.scene.n_free;
+        let order = &self.scene.slot_of_node;
+        match d {
+            2 => to_node_order::<2>(order, nf, x, &self.dof_velocities, &mut self.positions, &mut self.velocities),
+            _ => to_node_order::<3>(order, nf, x, &self.dof_velocities, &mut self.positions, &mut self.velocities),
         }
-        let g = &self.tunables.gravity;
-        let gravity_pe: f64 = (0..n).map(|k| -self.scene.dof_mass[k] * g[k % d] * (x[k] - self.scene.rest[k])).sum();
-        self.potential = elastic + gravity_pe;
-        match (&self.model, &self.reported_basis) {
-            (Model::Modal(m), _) => self.modal_coordinates.copy_from_slice(&m.q),
-            (Model::Full(f), Some(b)) => b.project_displacement(&self.scene.dof_mass, &f.u, &mut self.modal_coordinates),
-            (Model::Full(_), None) => {}
-        }
+        self.potential = elastic + gravity_potential;
     }
 
     pub fn time(&self) -> f64 {
@@ -407,6 +402,19 @@ impl Simulator {
         }
         self.refresh_outputs();
         Ok(())
+    }
+}
+
+/// Slot-ordered positions and free-DOF velocities into node order. Fixed
+/// length `D` keeps each copy a pair of moves instead of a `memmove` call.
+fn to_node_order<const D: usize>(slot_of_node: &[usize], n_free: usize, x: &[f64], v: &[f64], positions: &mut [f64], velocities: &mut [f64]) {
+    for ((&slot, p), vel) in slot_of_node.iter().zip(positions.chunks_exact_mut(D)).zip(velocities.chunks_exact_mut(D)) {
+        let xs: &[f64; D] = x[slot * D..slot * D + D].try_into().expect("D values");
+        *<&mut [f64; D]>::try_from(p).expect("D values") = *xs;
+        if slot < n_free {
+            let vs: &[f64; D] = v[slot * D..slot * D + D].try_into().expect("D values");
+            *<&mut [f64; D]>::try_from(vel).expect("D values") = *vs;
+        }
     }
 }
 
