@@ -14,7 +14,7 @@ fn main() {
     }
 
     // fmi-rs's schema support links libxml2 statically; a system libxml2.a
-    // (see modelDescription/xsd-test.sh) also needs these.
+    // (linked by `cargo xtask test` where GitHub is unreachable) also needs these.
     if std::env::var_os("CARGO_FEATURE_XSD").is_some() {
         for lib in ["icuuc", "z", "lzma"] {
             println!("cargo:rustc-link-arg-tests=-l{lib}");

@@ -67,7 +67,8 @@ fn validates_with_fmi_rs() {
 }
 
 /// XSD validation (fmi-rs `schema` feature): `cargo test --features xsd`,
-/// or modelDescription/xsd-test.sh where GitHub cannot be reached.
+/// which `cargo xtask test` runs (linking the system libxml2 where GitHub
+/// cannot be reached).
 #[cfg(feature = "xsd")]
 #[test]
 fn validates_against_the_fmi3_xsd() {
