@@ -2,7 +2,6 @@
 //! study (examples/report.rs) in release mode, then draws its plots with the
 //! project's Python environment (`cargo xtask setup` makes it).
 
-use std::path::Path;
 use std::process::Command;
 
 pub fn main(args: &[String]) -> Result<(), String> {
@@ -13,7 +12,9 @@ pub fn main(args: &[String]) -> Result<(), String> {
         .ok()
         .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string()))
         .unwrap_or_else(|| "unknown CPU".into());
+    let root = crate::setup::root();
     let mut cmd = Command::new(env!("CARGO"));
+    cmd.current_dir(&root);
     cmd.args(["run", "--release", "--example", "report", "--", "--out", &out]);
     if quick {
         cmd.arg("--quick");
@@ -23,11 +24,12 @@ pub fn main(args: &[String]) -> Result<(), String> {
     if !status.success() {
         return Err("the study failed".into());
     }
-    let python = Path::new(".venv/bin/python");
+    let python = crate::setup::python();
     if !python.exists() {
         return Err("no .venv: run `cargo xtask setup` first to draw the plots".into());
     }
     let status = Command::new(python)
+        .current_dir(&root)
         .args(["xtask/plot_report.py", &format!("{out}/error_vs_runtime.csv"), &out])
         .status()
         .map_err(|e| format!("cannot run python: {e}"))?;

@@ -149,10 +149,18 @@ pub fn test(args: &[String]) -> Result<(), String> {
     }
     lap("cargo test", &mut times);
 
+    step("cargo xtask report --quick");
+    let report_dir = target_dir(&root).join("report-quick");
+    if let Err(e) = crate::report::main(&["--quick".to_string(), "--out".to_string(), report_dir.display().to_string()]) {
+        failures.push(format!("report --quick: {e}"));
+    }
+    lap("report --quick", &mut times);
+
     step("pytest tests/python");
     let status = Command::new(setup::python())
         .current_dir(&root)
         .env("MMS_FMU_DIR", fmu_dir(&root))
+        .env("MMS_REPORT_DIR", &report_dir)
         .args(["-m", "pytest", "tests/python", "-ra", "-p", "no:cacheprovider"])
         .args(args)
         .status()
