@@ -1,13 +1,35 @@
-//! Cost of one internal step, modal (several r) against full space on the
-//! same scene, measured side by side in one run.
+//! Speed of stepping, measured side by side in one run:
+//!
+//! - `internal_step/SCENE`: one internal step, modal (r = 2, 8, 32) against
+//!   full space, both integrators (a call of 100 internal steps, divided by 100);
+//! - `do_step/paper-2d-top-row`: a communication step of one internal step,
+//!   through `Simulator::do_step` and through `fmi3DoStep` of the C ABI, beside
+//!   the internal step alone: the differences are the overheads of a call.
 //!
 //! cargo bench --bench step
 
+use std::ffi::CString;
+use std::ptr::{null, null_mut};
+use std::time::{Duration, Instant};
+
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use fmi_sys::fmi3::*;
+use modal_mass_spring::fmi::exports::*;
+use modal_mass_spring::fmi::variables::{vr, INSTANTIATION_TOKEN};
 use modal_mass_spring::physics::*;
 
+const PER_CALL: usize = 100;
+
+/// A simulator whose internal step is `dt` whatever the call length.
+fn simulator(p: &SceneParams, s: &SolverParams) -> (Simulator, f64) {
+    let probe = Simulator::new(p, s, &Tunables::physical(s.n_modes)).unwrap();
+    let dt = probe.max_stable_step().min(1e-4);
+    let fixed = SolverParams { max_internal_step: dt, ..s.clone() };
+    (Simulator::new(p, &fixed, &Tunables::physical(s.n_modes)).unwrap(), dt)
+}
+
 fn internal_step(c: &mut Criterion) {
-    for name in ["paper-2d-top-row", "paper-3d-sheet"] {
+    for name in SCENE_NAMES {
         let p = SceneParams::canonical(name).unwrap();
         let n = scene::Scene::build(&p).unwrap().n_dofs();
         let mut group = c.benchmark_group(format!("internal_step/{name}"));
@@ -19,15 +41,73 @@ fn internal_step(c: &mut Criterion) {
                 .collect();
             configs.push(("full".into(), SolverParams { reduction: Reduction::Full, n_modes: 0, integrator, ..SolverParams::default() }));
             for (label, s) in configs {
-                let mut sim = Simulator::new(&p, &s, &Tunables::physical(s.n_modes)).unwrap();
-                // One internal step per call: a step size inside every stability limit.
-                let dt = sim.max_stable_step().min(1e-4);
-                group.bench_function(BenchmarkId::new(format!("{integrator:?}"), label), |b| b.iter(|| sim.do_step(dt).unwrap()));
+                let (mut sim, dt) = simulator(&p, &s);
+                let h = dt * PER_CALL as f64 * (1.0 - 1e-9);
+                group.bench_function(BenchmarkId::new(format!("{integrator:?}"), label), |b| {
+                    b.iter_custom(|iters| {
+                        let t = Instant::now();
+                        for _ in 0..iters {
+                            sim.do_step(h).unwrap();
+                        }
+                        assert_eq!(sim.internal_steps_last(), PER_CALL);
+                        t.elapsed() / PER_CALL as u32
+                    })
+                });
             }
         }
         group.finish();
     }
 }
 
-criterion_group!(benches, internal_step);
+unsafe extern "C" fn silent(_: fmi3InstanceEnvironment, _: fmi3Status, _: fmi3String, _: fmi3String) {}
+
+fn do_step(c: &mut Criterion) {
+    let name = "paper-2d-top-row";
+    let p = SceneParams::canonical(name).unwrap();
+    let s = SolverParams::default();
+    let (mut many, dt) = simulator(&p, &s);
+    let (mut one, _) = simulator(&p, &s);
+    let mut group = c.benchmark_group(format!("do_step/{name}"));
+    group.bench_function("internal step alone", |b| {
+        b.iter_custom(|iters| {
+            let t = Instant::now();
+            for _ in 0..iters {
+                many.do_step(dt * PER_CALL as f64 * (1.0 - 1e-9)).unwrap();
+            }
+            t.elapsed() / PER_CALL as u32
+        })
+    });
+    group.bench_function("Simulator::do_step", |b| b.iter(|| one.do_step(dt).unwrap()));
+
+    // The default FMU (this scene, explicit, r = 2) with the same internal step.
+    let (name_c, token) = (CString::new("bench").unwrap(), CString::new(INSTANTIATION_TOKEN).unwrap());
+    let inst = unsafe { fmi3InstantiateCoSimulation(name_c.as_ptr(), token.as_ptr(), null(), false, false, false, false, null(), 0, null_mut(), Some(silent), None) };
+    assert!(!inst.is_null());
+    unsafe {
+        assert_eq!(fmi3SetFloat64(inst, &vr::MAX_INTERNAL_STEP, 1, &dt, 1), fmi3Status_fmi3OK);
+        assert_eq!(fmi3EnterInitializationMode(inst, false, 0.0, 0.0, false, 0.0), fmi3Status_fmi3OK);
+        assert_eq!(fmi3ExitInitializationMode(inst), fmi3Status_fmi3OK);
+    }
+    let mut time = 0.0;
+    group.bench_function("fmi3DoStep", |b| {
+        b.iter_custom(|iters| {
+            let (mut event, mut terminate, mut early, mut last) = (false, false, false, 0.0);
+            let t = Instant::now();
+            for _ in 0..iters {
+                let status = unsafe { fmi3DoStep(inst, time, dt, true, &mut event, &mut terminate, &mut early, &mut last) };
+                assert_eq!(status, fmi3Status_fmi3OK);
+                time += dt;
+            }
+            t.elapsed()
+        })
+    });
+    group.finish();
+    unsafe { fmi3FreeInstance(inst) };
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(2));
+    targets = do_step, internal_step
+}
 criterion_main!(benches);
