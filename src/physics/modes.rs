@@ -28,8 +28,11 @@ pub const MAX_DENSE_DOFS: usize = 8000;
 /// Scenes up to this many free DOFs always use the dense solver (it is
 /// cheap there and needs no convergence check).
 const PARTIAL_MIN_DOFS: usize = 600;
-/// The partial solver is used while r is at most this fraction of the DOFs.
-const PARTIAL_MAX_FRACTION: usize = 4;
+/// The partial solver is used while r is at most this fraction of the DOFs:
+/// its search space (2r vectors) must stay far below the dimension, where
+/// faer's Lanczos re-orthogonalisation can spin without end once the space
+/// becomes invariant (seen at r = 512 of 1740 coupled DOFs).
+const PARTIAL_MAX_FRACTION: usize = 16;
 
 /// The kept modes, lowest first.
 #[derive(Clone, Debug)]
@@ -126,6 +129,14 @@ impl ModalBasis {
             }
         }
         let block: Vec<usize> = (0..n).filter(|&k| coupled[k]).collect();
+        if r.min(block.len()) * PARTIAL_MAX_FRACTION > block.len() {
+            return Err(SimError {
+                message: format!(
+                    "nModes = {r} is too many for the partial eigensolver on {} coupled DOFs (at most 1/{PARTIAL_MAX_FRACTION} of them)",
+                    block.len()
+                ),
+            });
+        }
         let (block_lambda, block_vectors) = coupled_block_lowest(pattern, k_vals, mass, &block, r.min(block.len()), diag_max)?;
         // Merge with the isolated DOFs, lowest first (ties: block modes, then DOF order).
         let mut pairs: Vec<(f64, Result<usize, usize>)> = block_lambda.iter().enumerate().map(|(j, &l)| (l, Ok(j))).collect();
