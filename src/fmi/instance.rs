@@ -590,16 +590,17 @@ pub fn check_value(v: &Variable, x: Option<f64>) -> Result<(), String> {
     }
     if let Some(min) = v.min {
         if x < min {
-            return Err(format!("below min = {min}"));
+            return Err(if min == f64::MIN_POSITIVE {
+                format!("must be positive (min = {min:e})")
+            } else {
+                format!("below min = {min}")
+            });
         }
     }
     if let Some(max) = v.max {
         if x > max {
             return Err(format!("above max = {max}"));
         }
-    }
-    if v.positive && x <= 0.0 {
-        return Err("must be positive".into());
     }
     if !v.enum_values.is_empty() && !v.enum_values.iter().any(|&e| e as f64 == x) {
         return Err(format!("not one of the enumeration values {:?}", v.enum_values));
