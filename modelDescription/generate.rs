@@ -103,7 +103,21 @@ pub enum Dim {
     Param(String),
 }
 
+/// Lower bound of `positive` variables: the smallest positive normal double,
+/// since the XML `min` is inclusive and there is no exclusive minimum.
+pub const POSITIVE_MIN: f64 = f64::MIN_POSITIVE;
+
 impl Variable {
+    /// The `min` attribute of the XML and of the binary: `min`, raised to
+    /// [`POSITIVE_MIN`] for `positive` variables.
+    pub fn lower(&self) -> Option<f64> {
+        match (self.min, self.positive) {
+            (m, false) => m,
+            (Some(m), true) => Some(m.max(POSITIVE_MIN)),
+            (None, true) => Some(POSITIVE_MIN),
+        }
+    }
+
     pub fn dims(&self) -> Vec<Dim> {
         self.dimensions
             .iter()
@@ -173,6 +187,19 @@ impl Spec {
                 let t = v.declared_type.as_deref().ok_or(format!("{}: enumeration needs declared_type", v.name))?;
                 if !self.enumerations.iter().any(|e| e.name == t) {
                     return Err(format!("{}: unknown enumeration type {t}", v.name));
+                }
+            }
+            if let (Some(lo), Some(hi)) = (v.lower(), v.max) {
+                if lo > hi {
+                    return Err(format!("{}: min {lo} is above max {hi}", v.name));
+                }
+            }
+            if (v.min.is_some() || v.max.is_some() || v.positive) && !matches!(v.ty.as_str(), "Float64" | "UInt64") {
+                return Err(format!("{}: only Float64 and UInt64 variables have a range", v.name));
+            }
+            for x in v.start_numbers() {
+                if v.lower().is_some_and(|lo| x < lo) || v.max.is_some_and(|hi| x > hi) {
+                    return Err(format!("{}: start value {x} is outside its range", v.name));
                 }
             }
             // Stored as f64 in the binary: UInt64 values must stay exact.
@@ -336,7 +363,7 @@ impl Spec {
                 let t = &self.units.iter().find(|x| &x.name == u).unwrap().quantity;
                 let _ = write!(w, " declaredType=\"{}\"", esc(t));
             }
-            if let Some(m) = v.min {
+            if let Some(m) = v.lower() {
                 let _ = write!(w, " min=\"{}\"", number(&v.ty, m));
             }
             if let Some(m) = v.max {
@@ -490,15 +517,14 @@ impl Spec {
             let _ = writeln!(
                 r,
                 "    Variable {{ name: {:?}, vr: {}, ty: Type::{ty}, causality: Causality::{}, variability: Variability::{}, \
-                 start: &[{}], min: {}, max: {}, positive: {}, dims: &[{}], enum_values: &[{}] }},",
+                 start: &[{}], min: {}, max: {}, dims: &[{}], enum_values: &[{}] }},",
                 v.name,
                 v.vr,
                 camel(&v.causality),
                 camel(&v.variability),
                 start.join(", "),
-                opt(v.min),
+                opt(v.lower()),
                 opt(v.max),
-                v.positive,
                 dims.join(", "),
                 enum_values.join(", ")
             );

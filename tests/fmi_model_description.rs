@@ -155,3 +155,41 @@ fn c_header_declares_every_export() {
         assert!(h.contains(&format!(" fmi3{n}(")) || h.contains(&format!("*fmi3{n}(")), "fmi3{n} missing from the header");
     }
 }
+
+/// Value of attribute `attr` of the element of variable `name` in `xml`.
+fn attribute(xml: &str, name: &str, attr: &str) -> Option<f64> {
+    let start = xml.find(&format!(" name=\"{name}\""))?;
+    let tag = &xml[start..start + xml[start..].find('>')?];
+    let at = tag.find(&format!(" {attr}=\""))? + attr.len() + 3;
+    let value = &tag[at..at + tag[at..].find('"')?];
+    Some(value.parse().unwrap_or_else(|_| panic!("{name}: {attr}={value}")))
+}
+
+#[test]
+fn ranges_of_the_xml_are_those_the_binary_enforces() {
+    let xml = spec().model_description_xml(&BTreeMap::new()).unwrap();
+    for v in VARIABLES {
+        assert_eq!(attribute(&xml, v.name, "min"), v.min, "{}: min", v.name);
+        assert_eq!(attribute(&xml, v.name, "max"), v.max, "{}: max", v.name);
+    }
+    // Every numeric parameter has a range except gravity (any direction, any size).
+    let unbounded: Vec<&str> = VARIABLES
+        .iter()
+        .filter(|v| v.is_parameter() && matches!(v.ty, Type::Float64 | Type::UInt64) && v.min.is_none() && v.max.is_none())
+        .map(|v| v.name)
+        .collect();
+    assert_eq!(unbounded, ["gravity"]);
+    // Structural parameters are bounded on both sides (array sizes).
+    for v in VARIABLES.iter().filter(|v| v.causality == variables::Causality::StructuralParameter) {
+        assert!(v.min.is_some_and(|m| m >= 1.0) && v.max.is_some(), "{}", v.name);
+    }
+}
+
+#[test]
+fn a_start_value_outside_its_range_is_refused() {
+    let text = std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("modelDescription/variables.toml")).unwrap();
+    let broken = text.replacen("start = 0.1\npositive = true", "start = 0.0\npositive = true", 1);
+    assert_ne!(broken, text);
+    let e = generate::parse(&broken).unwrap_err();
+    assert!(e.contains("spacing: start value 0 is outside its range"), "{e}");
+}

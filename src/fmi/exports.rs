@@ -10,7 +10,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use fmi_sys::fmi3::*;
 
-use super::instance::{log_raw, mask, slice, Instance, ERROR, FATAL, OK};
+use super::instance::{log_raw, mask, slice, too_many, Instance, ERROR, FATAL, OK};
 use super::model::Params;
 use super::serialize;
 use super::variables::{index_of, Type, INSTANTIATION_TOKEN, VARIABLES};
@@ -55,6 +55,9 @@ fn no_variables(inst: &mut Instance, f: &str, type_name: &str, vrs: *const fmi3V
     inst.guard(f, mask)?;
     if n > 0 && vrs.is_null() {
         return Err(inst.fail(&format!("{f}: valueReferences is NULL")));
+    }
+    if too_many::<fmi3ValueReference>(n) {
+        return Err(inst.fail(&format!("{f}: nValueReferences = {n} cannot be an array size")));
     }
     if let Some(&r) = unsafe { slice(vrs, n) }.first() {
         return Err(match index_of(r) {
@@ -127,7 +130,14 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
         if nRequiredIntermediateVariables > 0 {
             return fail("this FMU provides no intermediate update (providesIntermediateUpdate = false)".into());
         }
-        let name = if instanceName.is_null() { String::new() } else { unsafe { CStr::from_ptr(instanceName) }.to_string_lossy().into_owned() };
+        // The standard requires a non-empty name; messages are labelled with it.
+        if instanceName.is_null() {
+            return fail("instanceName is NULL".into());
+        }
+        let name = unsafe { CStr::from_ptr(instanceName) }.to_string_lossy().into_owned();
+        if name.trim().is_empty() {
+            return fail("instanceName is empty".into());
+        }
         let start = if resourcePath.is_null() {
             Params::start()
         } else {
@@ -593,7 +603,7 @@ pub unsafe extern "C" fn fmi3GetFMUState(instance: fmi3Instance, FMUState: *mut 
     call(instance, "fmi3GetFMUState", |inst| {
         inst.guard("fmi3GetFMUState", mask::ANY)?;
         let s = inst.capture();
-        unsafe { inst.store_state(FMUState, s) }
+        unsafe { inst.store_state("fmi3GetFMUState", FMUState, s) }
     })
 }
 const _: fmi3GetFMUStateTYPE = Some(fmi3GetFMUState);
@@ -602,7 +612,7 @@ const _: fmi3GetFMUStateTYPE = Some(fmi3GetFMUState);
 pub unsafe extern "C" fn fmi3SetFMUState(instance: fmi3Instance, FMUState: fmi3FMUState) -> fmi3Status {
     call(instance, "fmi3SetFMUState", |inst| {
         inst.guard("fmi3SetFMUState", mask::ANY)?;
-        let s = unsafe { inst.state_from_ptr(FMUState)? }.clone();
+        let s = inst.state_from_ptr("fmi3SetFMUState", FMUState)?.clone();
         inst.restore(&s)
     })
 }
@@ -620,7 +630,7 @@ pub unsafe extern "C" fn fmi3SerializedFMUStateSize(instance: fmi3Instance, FMUS
         if size.is_null() {
             return Err(inst.fail("fmi3SerializedFMUStateSize: size is NULL"));
         }
-        let s = unsafe { inst.state_from_ptr(FMUState)? };
+        let s = inst.state_from_ptr("fmi3SerializedFMUStateSize", FMUState)?;
         unsafe { *size = serialize::encode(s).len() };
         Ok(OK)
     })
@@ -630,7 +640,7 @@ const _: fmi3SerializedFMUStateSizeTYPE = Some(fmi3SerializedFMUStateSize);
 #[no_mangle]
 pub unsafe extern "C" fn fmi3SerializeFMUState(instance: fmi3Instance, FMUState: fmi3FMUState, serializedState: *mut fmi3Byte, size: usize) -> fmi3Status {
     call(instance, "fmi3SerializeFMUState", |inst| {
-        let s = unsafe { inst.state_from_ptr(FMUState)? };
+        let s = inst.state_from_ptr("fmi3SerializeFMUState", FMUState)?;
         let bytes = serialize::encode(s);
         if serializedState.is_null() {
             return Err(inst.fail("fmi3SerializeFMUState: serializedState is NULL"));
@@ -653,6 +663,9 @@ pub unsafe extern "C" fn fmi3DeserializeFMUState(instance: fmi3Instance, seriali
         if serializedState.is_null() || FMUState.is_null() {
             return Err(inst.fail("fmi3DeserializeFMUState: serializedState or FMUState is NULL"));
         }
+        if too_many::<fmi3Byte>(size) {
+            return Err(inst.fail(&format!("fmi3DeserializeFMUState: size = {size} cannot be an array size")));
+        }
         let bytes = unsafe { slice(serializedState, size) };
         let s = serialize::decode(bytes).map_err(|m| inst.fail(&format!("fmi3DeserializeFMUState: {m}")))?;
         let mine = inst.structural();
@@ -662,7 +675,7 @@ pub unsafe extern "C" fn fmi3DeserializeFMUState(instance: fmi3Instance, seriali
                 "fmi3DeserializeFMUState: the state is from an instance with structural parameters {theirs:?}, this one has {mine:?}"
             )));
         }
-        unsafe { inst.store_state(FMUState, s) }
+        unsafe { inst.store_state("fmi3DeserializeFMUState", FMUState, s) }
     })
 }
 const _: fmi3DeserializeFMUStateTYPE = Some(fmi3DeserializeFMUState);

@@ -1,7 +1,9 @@
 //! One FMU instance: the FMI state machine, argument checks, logging and the
 //! generic Get/Set of the variable table. Model specifics are in [`super::model`].
 
+use std::collections::BTreeSet;
 use std::ffi::{CStr, CString};
+use std::sync::{Mutex, MutexGuard};
 
 use fmi_sys::fmi3::*;
 
@@ -18,6 +20,22 @@ pub const FATAL: fmi3Status = fmi3Status_fmi3Fatal;
 /// Checked on every call so a stale or foreign pointer is refused, not used.
 const INSTANCE_MAGIC: u64 = 0x4d4d_535f_494e_5354;
 const STATE_MAGIC: u64 = 0x4d4d_535f_5354_4154;
+
+/// Addresses of the live instances of this process. A pointer the host passes
+/// is dereferenced only if it is in here, so a freed, stale or foreign
+/// pointer is refused without touching the memory it points to.
+static LIVE: Mutex<BTreeSet<usize>> = Mutex::new(BTreeSet::new());
+
+fn live() -> MutexGuard<'static, BTreeSet<usize>> {
+    // The set stays consistent even if a holder panicked: insert/remove are atomic.
+    LIVE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Two times within rounding of each other (communication points and stop
+/// times accumulated differently by the importer).
+pub fn same_time(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0)
+}
 
 /// States of the FMI 3.0 Co-Simulation state machine this FMU can be in
 /// (no Event Mode, no intermediate update, no clocks).
@@ -62,14 +80,16 @@ pub struct FmuState {
     magic: u64,
     pub mode: Mode,
     pub start_time: f64,
+    /// stopTime of fmi3EnterInitializationMode, if it was defined.
+    pub stop_time: Option<f64>,
     pub params: Params,
     /// Present whenever the simulator was up to date with `params`.
     pub snapshot: Option<Snapshot>,
 }
 
 impl FmuState {
-    pub fn new(mode: Mode, start_time: f64, params: Params, snapshot: Option<Snapshot>) -> Self {
-        FmuState { magic: STATE_MAGIC, mode, start_time, params, snapshot }
+    pub fn new(mode: Mode, start_time: f64, stop_time: Option<f64>, params: Params, snapshot: Option<Snapshot>) -> Self {
+        FmuState { magic: STATE_MAGIC, mode, start_time, stop_time, params, snapshot }
     }
 }
 
@@ -89,6 +109,10 @@ pub struct Instance {
     sim: Option<Simulator>,
     stale: bool,
     start_time: f64,
+    stop_time: Option<f64>,
+    /// FMU states made by this instance and not freed yet; only these are
+    /// dereferenced, and fmi3FreeInstance frees those the host left.
+    states: BTreeSet<usize>,
 }
 
 type R = Result<fmi3Status, fmi3Status>;
@@ -108,27 +132,41 @@ impl Instance {
             sim: None,
             stale: true,
             start_time: 0.0,
+            stop_time: None,
+            states: BTreeSet::new(),
         }
     }
 
+    /// The instance behind `p`, if `p` is a live instance of this FMU.
+    ///
     /// # Safety
-    /// `p` must be null or a pointer returned by `into_raw` and not yet freed.
+    /// The instance must not be used from another thread at the same time
+    /// (FMI instances are not thread-safe; different instances are).
     pub unsafe fn from_ptr<'a>(p: fmi3Instance) -> Option<&'a mut Instance> {
-        let inst = (p as *mut Instance).as_mut()?;
+        if p.is_null() || !live().contains(&(p as usize)) {
+            return None;
+        }
+        let inst = &mut *(p as *mut Instance);
         (inst.magic == INSTANCE_MAGIC).then_some(inst)
     }
 
     pub fn into_raw(self) -> fmi3Instance {
-        Box::into_raw(Box::new(self)) as fmi3Instance
+        let p = Box::into_raw(Box::new(self)) as fmi3Instance;
+        live().insert(p as usize);
+        p
     }
 
+    /// Frees a live instance and the FMU states it still owns; anything else is ignored.
+    ///
     /// # Safety
     /// As for [`Instance::from_ptr`]; the pointer is invalid afterwards.
     pub unsafe fn free(p: fmi3Instance) {
-        if let Some(inst) = Self::from_ptr(p) {
-            inst.magic = 0;
-            drop(Box::from_raw(p as *mut Instance));
+        if p.is_null() || !live().remove(&(p as usize)) {
+            return;
         }
+        let inst = &mut *(p as *mut Instance);
+        inst.magic = 0;
+        drop(Box::from_raw(p as *mut Instance));
     }
 
     // ---- logging ---------------------------------------------------------
@@ -141,8 +179,9 @@ impl Instance {
             ERROR => "logStatusError",
             _ => "logStatusFatal",
         };
-        // Errors always reach the host; the rest only when asked for.
-        let enabled = status >= ERROR
+        // Failures (discarded steps, errors) always reach the host with their
+        // reason; the rest only when asked for.
+        let enabled = status >= DISCARD
             || (self.logging_on && (self.category_on(category) || self.category_on("logAll")));
         if enabled {
             log_raw(self.env, self.logger, status, category, message);
@@ -161,7 +200,12 @@ impl Instance {
 
     pub fn guard(&self, function: &str, mask: u32) -> Result<(), fmi3Status> {
         if mask & self.mode.bit() == 0 {
-            return Err(self.fail(&format!("{function} may not be called in {:?}", self.mode)));
+            let allowed: Vec<String> = (0..5).filter_map(Mode::from_u8).filter(|m| mask & m.bit() != 0).map(|m| format!("{m:?}")).collect();
+            return Err(self.fail(&format!(
+                "{function}: illegal call sequence: not allowed in {:?}, only in {}",
+                self.mode,
+                allowed.join(", ")
+            )));
         }
         Ok(())
     }
@@ -170,7 +214,10 @@ impl Instance {
         if n > 0 && categories.is_null() {
             return Err(self.fail("fmi3SetDebugLogging: categories is NULL but nCategories > 0"));
         }
-        let mut selected = Vec::with_capacity(n);
+        if too_many::<fmi3String>(n) {
+            return Err(self.fail(&format!("fmi3SetDebugLogging: nCategories = {n} cannot be an array size")));
+        }
+        let mut selected = Vec::new();
         for &c in unsafe { slice(categories, n) } {
             if c.is_null() {
                 return Err(self.fail("fmi3SetDebugLogging: a category is NULL"));
@@ -239,6 +286,7 @@ impl Instance {
             }
         }
         self.start_time = start_time;
+        self.stop_time = stop_time;
         self.mode = Mode::InitializationMode;
         Ok(OK)
     }
@@ -281,6 +329,7 @@ impl Instance {
         self.sim = None;
         self.stale = true;
         self.start_time = 0.0;
+        self.stop_time = None;
         Ok(OK)
     }
 
@@ -309,8 +358,14 @@ impl Instance {
         if !(h.is_finite() && h > 0.0) {
             return Err(self.fail(&format!("fmi3DoStep: communicationStepSize must be finite and positive, got {h}")));
         }
-        if !t.is_finite() || (t - now).abs() > 1e-9 * now.abs().max(1.0) {
+        if !t.is_finite() || !same_time(t, now) {
             return Err(self.fail(&format!("fmi3DoStep: currentCommunicationPoint {t} does not match the FMU time {now}")));
+        }
+        if let Some(stop) = self.stop_time {
+            let end = now + h;
+            if end > stop && !same_time(end, stop) {
+                return Err(self.fail(&format!("fmi3DoStep: the step would end at {end}, past stopTime {stop}")));
+            }
         }
         let sim = self.sim.as_mut().expect("Step Mode has a simulator");
         match sim.do_step(h) {
@@ -328,6 +383,24 @@ impl Instance {
 
     // ---- Get/Set -----------------------------------------------------------
 
+    /// The value references of a Get/Set call, after the NULL and size checks
+    /// of both arrays.
+    ///
+    /// # Safety
+    /// `vrs` must point to `n_vrs` elements unless it is NULL or `n_vrs` is 0.
+    unsafe fn value_references<'a, T>(&self, f: &str, vrs: *const u32, n_vrs: usize, values: *const T, n_values: usize) -> Result<&'a [u32], fmi3Status> {
+        if n_vrs > 0 && vrs.is_null() {
+            return Err(self.fail(&format!("{f}: valueReferences is NULL but nValueReferences = {n_vrs}")));
+        }
+        if n_values > 0 && values.is_null() {
+            return Err(self.fail(&format!("{f}: values is NULL but nValues = {n_values}")));
+        }
+        if too_many::<u32>(n_vrs) || too_many::<T>(n_values) {
+            return Err(self.fail(&format!("{f}: nValueReferences = {n_vrs} or nValues = {n_values} cannot be an array size")));
+        }
+        Ok(slice(vrs, n_vrs))
+    }
+
     /// Looks up every value reference, checks its type and counts the values.
     fn resolve(&self, f: &str, ty: Type, vrs: &[u32], n_values: usize) -> Result<(), fmi3Status> {
         let mut total = 0usize;
@@ -339,7 +412,7 @@ impl Instance {
             if v.ty != ty {
                 return Err(self.fail(&format!("{f}: {} (value reference {r}) is accessed with fmi3Get/Set{}", v.name, v.ty.name())));
             }
-            total += self.params.size_of(v);
+            total = total.saturating_add(self.params.size_of(v));
         }
         if total != n_values {
             return Err(self.fail(&format!(
@@ -363,10 +436,8 @@ impl Instance {
         conv: impl Fn(f64) -> T,
     ) -> R {
         self.guard(f, mask::GET)?;
-        if (n_vrs > 0 && vrs.is_null()) || (n_values > 0 && values.is_null()) {
-            return Err(self.fail(&format!("{f}: valueReferences or values is NULL")));
-        }
-        let vrs = slice(vrs, n_vrs);
+        let vrs = self.value_references(f, vrs, n_vrs, values as *const T, n_values)?;
+        // nValues is checked against the variables before `values` is touched.
         self.resolve(f, ty, vrs, n_values)?;
         let needs_sim = vrs.iter().any(|&r| {
             let v = &VARIABLES[index_of(r).unwrap()];
@@ -433,12 +504,10 @@ impl Instance {
         conv: impl Fn(T) -> Option<f64>,
     ) -> R {
         self.guard(f, mask::SET)?;
-        if (n_vrs > 0 && vrs.is_null()) || (n_values > 0 && values.is_null()) {
-            return Err(self.fail(&format!("{f}: valueReferences or values is NULL")));
-        }
-        let vrs = slice(vrs, n_vrs);
-        let values = slice(values, n_values);
+        let vrs = self.value_references(f, vrs, n_vrs, values, n_values)?;
+        // nValues is checked against the variables before `values` is read.
         self.resolve(f, ty, vrs, n_values)?;
+        let values = slice(values, n_values);
         let mut k = 0;
         for &r in vrs {
             let v = &VARIABLES[index_of(r).unwrap()];
@@ -494,44 +563,56 @@ impl Instance {
 
     pub fn capture(&self) -> FmuState {
         let snapshot = self.sim.as_ref().filter(|_| !self.stale).map(|s| s.snapshot());
-        FmuState::new(self.mode, self.start_time, self.params.clone(), snapshot)
+        FmuState::new(self.mode, self.start_time, self.stop_time, self.params.clone(), snapshot)
     }
 
-    /// # Safety
-    /// `state` must be null or a pointer made by `into_raw_state`.
-    pub unsafe fn state_from_ptr<'a>(&self, state: fmi3FMUState) -> Result<&'a mut FmuState, fmi3Status> {
-        match (state as *mut FmuState).as_mut() {
-            Some(s) if s.magic == STATE_MAGIC => Ok(s),
-            Some(_) => Err(self.fail("FMUState does not point to a state of this FMU")),
-            None => Err(self.fail("FMUState is NULL")),
+    /// The state behind `state` if this instance made it and has not freed it;
+    /// anything else (NULL, freed, another instance's) is refused unread.
+    pub fn state_from_ptr<'a>(&self, f: &str, state: fmi3FMUState) -> Result<&'a mut FmuState, fmi3Status> {
+        if state.is_null() {
+            return Err(self.fail(&format!("{f}: FMUState is NULL")));
         }
+        if !self.states.contains(&(state as usize)) {
+            return Err(self.fail(&format!("{f}: FMUState is not a live state of this instance (freed, or made by another one)")));
+        }
+        // SAFETY: addresses in `states` are live Box<FmuState>s owned by this instance.
+        let s = unsafe { &mut *(state as *mut FmuState) };
+        debug_assert_eq!(s.magic, STATE_MAGIC);
+        Ok(s)
     }
 
     /// Stores `s` in `*out`, reusing the state already there.
-    pub unsafe fn store_state(&self, out: *mut fmi3FMUState, s: FmuState) -> R {
+    ///
+    /// # Safety
+    /// `out` must be null or point to writable memory for one pointer.
+    pub unsafe fn store_state(&mut self, f: &str, out: *mut fmi3FMUState, s: FmuState) -> R {
         if out.is_null() {
-            return Err(self.fail("FMUState is NULL"));
+            return Err(self.fail(&format!("{f}: FMUState is NULL")));
         }
         if !(*out).is_null() {
-            let existing = self.state_from_ptr(*out)?;
+            let existing = self.state_from_ptr(f, *out)?;
             *existing = s;
         } else {
-            *out = Box::into_raw(Box::new(s)) as fmi3FMUState;
+            let p = Box::into_raw(Box::new(s)) as fmi3FMUState;
+            self.states.insert(p as usize);
+            *out = p;
         }
         Ok(OK)
     }
 
     /// # Safety
-    /// `out` must be null or point to a null or live state pointer.
-    pub unsafe fn free_state(&self, out: *mut fmi3FMUState) -> R {
+    /// `out` must be null or point to a readable and writable state pointer.
+    pub unsafe fn free_state(&mut self, out: *mut fmi3FMUState) -> R {
+        const F: &str = "fmi3FreeFMUState";
         if out.is_null() {
-            return Err(self.fail("fmi3FreeFMUState: FMUState is NULL"));
+            return Err(self.fail(&format!("{F}: FMUState is NULL")));
         }
         if (*out).is_null() {
             return Ok(OK);
         }
-        let s = self.state_from_ptr(*out)?;
+        let s = self.state_from_ptr(F, *out)?;
         s.magic = 0;
+        self.states.remove(&(*out as usize));
         drop(Box::from_raw(s as *mut FmuState));
         *out = std::ptr::null_mut();
         Ok(OK)
@@ -550,9 +631,17 @@ impl Instance {
                         Err(e) => return Err(self.fail(&format!("fmi3SetFMUState: cannot set up the simulator: {e}"))),
                     }
                 };
+                // Restoring in place must be undoable: the state may be refused after it.
+                let prior = if reuse { self.sim.as_ref().map(|s| s.snapshot()) } else { None };
                 let target = sim.as_mut().or(self.sim.as_mut()).unwrap();
                 if let Err(e) = target.restore(snap) {
                     return Err(self.fail(&format!("fmi3SetFMUState: {e}")));
+                }
+                if !outputs_finite(target) {
+                    if let Some(p) = prior {
+                        let _ = target.restore(&p);
+                    }
+                    return Err(self.fail("fmi3SetFMUState: the state gives non-finite outputs (positions, velocities or energies)"));
                 }
                 sim
             }
@@ -569,6 +658,7 @@ impl Instance {
         self.params = s.params.clone();
         self.mode = s.mode;
         self.start_time = s.start_time;
+        self.stop_time = s.stop_time;
         Ok(OK)
     }
 
@@ -582,6 +672,24 @@ impl Instance {
     }
 }
 
+impl Drop for Instance {
+    fn drop(&mut self) {
+        for p in std::mem::take(&mut self.states) {
+            // SAFETY: every address in `states` is a live Box<FmuState> made by `store_state`.
+            let s = unsafe { &mut *(p as *mut FmuState) };
+            s.magic = 0;
+            drop(unsafe { Box::from_raw(p as *mut FmuState) });
+        }
+    }
+}
+
+/// Every output of the simulator is a finite number.
+pub fn outputs_finite(sim: &Simulator) -> bool {
+    [sim.positions(), sim.velocities(), sim.modal_coordinates(), &[sim.kinetic_energy(), sim.potential_energy()]]
+        .iter()
+        .all(|a| a.iter().all(|x| x.is_finite()))
+}
+
 /// Range checks from the model description; `None` means not representable.
 pub fn check_value(v: &Variable, x: Option<f64>) -> Result<(), String> {
     let x = x.ok_or("out of the range this FMU can store")?;
@@ -590,16 +698,17 @@ pub fn check_value(v: &Variable, x: Option<f64>) -> Result<(), String> {
     }
     if let Some(min) = v.min {
         if x < min {
-            return Err(format!("below min = {min}"));
+            return Err(if min == f64::MIN_POSITIVE {
+                format!("must be positive (min = {min:e})")
+            } else {
+                format!("below min = {min}")
+            });
         }
     }
     if let Some(max) = v.max {
         if x > max {
             return Err(format!("above max = {max}"));
         }
-    }
-    if v.positive && x <= 0.0 {
-        return Err("must be positive".into());
     }
     if !v.enum_values.is_empty() && !v.enum_values.iter().any(|&e| e as f64 == x) {
         return Err(format!("not one of the enumeration values {:?}", v.enum_values));
@@ -616,17 +725,29 @@ pub fn log_raw(env: fmi3InstanceEnvironment, logger: fmi3LogMessageCallback, sta
     }
 }
 
+/// True if `n` elements of `T` cannot be one array in memory: such a count is
+/// refused before it reaches `slice::from_raw_parts` (whose contract it breaks).
+pub fn too_many<T>(n: usize) -> bool {
+    n > isize::MAX as usize / std::mem::size_of::<T>().max(1)
+}
+
 /// Slice from a C array; a null pointer is fine when `n` is 0.
+///
+/// # Safety
+/// Unless `n` is 0, `p` must point to `n` readable elements; callers check
+/// `p` for NULL and `n` with [`too_many`] first.
 pub unsafe fn slice<'a, T>(p: *const T, n: usize) -> &'a [T] {
-    if n == 0 {
+    if n == 0 || p.is_null() || too_many::<T>(n) {
         &[]
     } else {
         std::slice::from_raw_parts(p, n)
     }
 }
 
+/// # Safety
+/// As for [`slice`], writable.
 pub unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> &'a mut [T] {
-    if n == 0 {
+    if n == 0 || p.is_null() || too_many::<T>(n) {
         &mut []
     } else {
         std::slice::from_raw_parts_mut(p, n)

@@ -6,8 +6,8 @@
 //! | 4 | format version |
 //! | 8 | fingerprint of the variable layout |
 //! | 8 | payload length |
-//! | n | payload: mode, start time, every parameter (vr, length, values), simulator snapshot |
-//! | 8 | FNV-1a 64 checksum of everything before |
+//! | n | payload: mode, start time, stop time, every parameter (vr, length, values), simulator snapshot |
+//! | 4 | CRC-32 (IEEE) of everything before |
 //!
 //! Decoding checks all of it and every value against the model description,
 //! so a corrupted or foreign blob is refused instead of loaded.
@@ -17,14 +17,47 @@ use super::model::Params;
 use super::variables::{index_of, LAYOUT_FINGERPRINT, VARIABLES};
 use crate::physics::{Snapshot, Tunables};
 
-const MAGIC: &[u8; 8] = b"MMSFMU3S";
-const VERSION: u32 = 1;
-const HEADER: usize = 8 + 4 + 8 + 8;
+pub const MAGIC: &[u8; 8] = b"MMSFMU3S";
+/// 1: FNV-1a checksum, no stop time; 2: CRC-32, stop time.
+pub const VERSION: u32 = 2;
+/// Bytes before the payload.
+pub const HEADER: usize = 8 + 4 + 8 + 8;
+/// Bytes after the payload.
+pub const TRAILER: usize = 4;
+
+pub fn checksum(bytes: &[u8]) -> u32 {
+    crc32fast::hash(bytes)
+}
+
+/// Header, `payload` and checksum: a blob [`decode`] reads if the payload is valid.
+pub fn seal(payload: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(HEADER + payload.len() + TRAILER);
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&VERSION.to_le_bytes());
+    out.extend_from_slice(&LAYOUT_FINGERPRINT.to_le_bytes());
+    put_u64(&mut out, payload.len() as u64);
+    out.extend_from_slice(payload);
+    let sum = checksum(&out);
+    out.extend_from_slice(&sum.to_le_bytes());
+    out
+}
 
 pub fn encode(s: &FmuState) -> Vec<u8> {
+    seal(&payload(s))
+}
+
+/// The payload of [`encode`], without header and checksum.
+pub fn payload(s: &FmuState) -> Vec<u8> {
     let mut p = Vec::new();
     p.push(s.mode as u8);
     put_f64(&mut p, s.start_time);
+    match s.stop_time {
+        None => p.push(0),
+        Some(t) => {
+            p.push(1);
+            put_f64(&mut p, t);
+        }
+    }
     let params: Vec<usize> = (0..VARIABLES.len()).filter(|&i| VARIABLES[i].is_parameter()).collect();
     put_u64(&mut p, params.len() as u64);
     for i in params {
@@ -44,19 +77,14 @@ pub fn encode(s: &FmuState) -> Vec<u8> {
             put_f64s(&mut p, &t.mode_weights);
         }
     }
-    let mut out = Vec::with_capacity(HEADER + p.len() + 8);
-    out.extend_from_slice(MAGIC);
-    out.extend_from_slice(&VERSION.to_le_bytes());
-    out.extend_from_slice(&LAYOUT_FINGERPRINT.to_le_bytes());
-    put_u64(&mut out, p.len() as u64);
-    out.extend_from_slice(&p);
-    let sum = fnv1a(&out);
-    put_u64(&mut out, sum);
-    out
+    p
 }
 
 pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
-    if bytes.len() < HEADER + 8 {
+    if bytes.is_empty() {
+        return Err("the serialized state is empty".into());
+    }
+    if bytes.len() < HEADER + TRAILER {
         return Err(format!("{} bytes is too short for a serialized state", bytes.len()));
     }
     if &bytes[..8] != MAGIC {
@@ -71,12 +99,12 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
         return Err("serialized state of a different model description".into());
     }
     let len = u64::from_le_bytes(bytes[20..28].try_into().unwrap());
-    if len != (bytes.len() - HEADER - 8) as u64 {
-        return Err(format!("payload length {len} does not match the {} bytes given", bytes.len()));
+    if len != (bytes.len() - HEADER - TRAILER) as u64 {
+        return Err(format!("payload length {len} does not match the {} bytes given (truncated or extended)", bytes.len()));
     }
-    let (body, tail) = bytes.split_at(bytes.len() - 8);
-    if fnv1a(body) != u64::from_le_bytes(tail.try_into().unwrap()) {
-        return Err("checksum mismatch: the serialized state is corrupted".into());
+    let (body, tail) = bytes.split_at(bytes.len() - TRAILER);
+    if checksum(body) != u32::from_le_bytes(tail.try_into().unwrap()) {
+        return Err("CRC-32 mismatch: the serialized state is corrupted".into());
     }
     let mut r = Reader { b: &body[HEADER..] };
     let mode = Mode::from_u8(r.u8()?).ok_or("bad mode")?;
@@ -84,6 +112,17 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
     if !start_time.is_finite() {
         return Err("start time is not finite".into());
     }
+    let stop_time = match r.u8()? {
+        0 => None,
+        1 => {
+            let t = r.f64()?;
+            if t.is_nan() || t < start_time {
+                return Err(format!("stop time {t} is before the start time {start_time}"));
+            }
+            Some(t)
+        }
+        _ => return Err("bad stop time flag".into()),
+    };
     let mut params = Params { values: vec![Vec::new(); VARIABLES.len()] };
     let n = r.u64()?;
     let mut seen = vec![false; VARIABLES.len()];
@@ -124,6 +163,9 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
             let damping_alpha = r.f64()?;
             let damping_beta = r.f64()?;
             let mode_weights = r.f64s()?;
+            if !(time.is_finite() && time >= 0.0) || !state.iter().all(|x| x.is_finite()) {
+                return Err("the simulator state holds a negative or non-finite time or non-finite values".into());
+            }
             Some(Snapshot { time, state, tunables: Tunables { gravity, damping_alpha, damping_beta, mode_weights } })
         }
         _ => return Err("bad snapshot flag".into()),
@@ -139,7 +181,12 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
             return Err("simulator tunables differ from the parameters".into());
         }
     }
-    Ok(FmuState::new(mode, start_time, params, snapshot))
+    if mode == Mode::Instantiated || mode == Mode::ConfigurationMode {
+        if stop_time.is_some() {
+            return Err("a state before initialization has no stop time".into());
+        }
+    }
+    Ok(FmuState::new(mode, start_time, stop_time, params, snapshot))
 }
 
 fn put_u64(v: &mut Vec<u8>, x: u64) {
@@ -151,15 +198,6 @@ fn put_f64(v: &mut Vec<u8>, x: f64) {
 fn put_f64s(v: &mut Vec<u8>, x: &[f64]) {
     put_u64(v, x.len() as u64);
     x.iter().for_each(|x| put_f64(v, *x));
-}
-
-fn fnv1a(b: &[u8]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for &x in b {
-        h ^= x as u64;
-        h = h.wrapping_mul(0x0100_0000_01b3);
-    }
-    h
 }
 
 struct Reader<'a> {

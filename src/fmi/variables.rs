@@ -53,10 +53,11 @@ pub struct Variable {
     /// Start values (booleans as 0/1); arrays sized by structural parameters
     /// are fitted by repeating the first element.
     pub start: &'static [f64],
+    /// Range of the model description (inclusive), enforced by every setter,
+    /// by startValues.txt and by deserialization. Variables declared
+    /// `positive` have min = the smallest positive normal double.
     pub min: Option<f64>,
     pub max: Option<f64>,
-    /// Values must be > 0.
-    pub positive: bool,
     pub dims: &'static [Dim],
     /// Allowed values of an enumeration (empty otherwise).
     pub enum_values: &'static [i64],
