@@ -4,15 +4,19 @@
 //!   then the main job `python/main_job.py` (fmpy simulates the default scene,
 //!   prints a summary and writes `out/default_scene.png`).
 //! - `test [PYTEST ARGS...]`: setup, build the default FMU and one scene-baked FMU
-//!   per canonical scene into `target/fmu/`, run `cargo test --workspace`, then
-//!   pytest on `tests/python` with the venv's Python. Both suites always run;
-//!   the task fails if either fails.
+//!   per canonical scene into `target/fmu/`, run `cargo test --workspace`
+//!   (the soak run of a million steps included), pytest on `tests/python` with
+//!   the venv's Python, the valgrind leak check, and each fuzz target for
+//!   FUZZ_SECONDS. Every stage always runs; the task fails if any fails.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use crate::{fmu, setup};
+use crate::{fmu, fuzz, setup, valgrind};
+
+/// Fuzzing time per target in `cargo xtask test` (CI): bounded, see README.
+const FUZZ_SECONDS: u64 = 30;
 
 fn target_dir(root: &Path) -> PathBuf {
     match std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from) {
@@ -119,11 +123,30 @@ pub fn test(args: &[String]) -> Result<(), String> {
         None => failures.push(format!("pytest was killed ({status})")),
     }
     lap("pytest", &mut times);
+
+    step("valgrind: cargo xtask valgrind");
+    if let Err(e) = valgrind::main(&[]) {
+        failures.push(e);
+    }
+    lap("valgrind", &mut times);
+
+    step(&format!("fuzzing: cargo xtask fuzz --seconds {FUZZ_SECONDS}"));
+    let targets: Vec<String> = Vec::new();
+    match fuzz::run(&targets, FUZZ_SECONDS, false) {
+        Ok(reports) => {
+            for r in reports {
+                eprintln!("fuzz {}: {} executions in {:.0} s, no crash", r.target, r.runs, r.seconds);
+            }
+        }
+        Err(e) => failures.push(e),
+    }
+    lap("fuzz", &mut times);
+
     let summary: Vec<String> = times.iter().map(|(n, t)| format!("{n} {t:.0} s")).collect();
     eprintln!("\ntimes: {}", summary.join(", "));
 
     if failures.is_empty() {
-        eprintln!("\nall tests passed (cargo test and pytest)");
+        eprintln!("\nall tests passed (cargo test, pytest, valgrind, fuzzing)");
         Ok(())
     } else {
         Err(format!("failed: {}", failures.join("; ")))
