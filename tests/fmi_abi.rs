@@ -130,6 +130,8 @@ fn do_step_arguments() {
     assert!((f.time() - 0.2).abs() < 1e-12);
     // Communication points accumulated differently by the importer are accepted.
     assert_eq!(f.step(0.2 + 1e-14, 0.01), OK);
+    // So is the smallest step there is.
+    assert_eq!(f.step(f.time(), 5e-324), OK, "{:?}", f.messages());
     let p = f.positions();
     assert!(p.iter().all(|x| x.is_finite()));
     // Bottom-left node (row 9, col 0) falls; the top row stays fixed.
