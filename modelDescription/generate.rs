@@ -88,8 +88,6 @@ pub struct Variable {
     #[serde(default)]
     pub max: Option<f64>,
     #[serde(default)]
-    pub positive: bool,
-    #[serde(default)]
     pub unit: Option<String>,
     pub description: String,
     #[serde(default)]
@@ -103,21 +101,7 @@ pub enum Dim {
     Param(String),
 }
 
-/// Lower bound of `positive` variables: the smallest positive normal double,
-/// since the XML `min` is inclusive and there is no exclusive minimum.
-pub const POSITIVE_MIN: f64 = f64::MIN_POSITIVE;
-
 impl Variable {
-    /// The `min` attribute of the XML and of the binary: `min`, raised to
-    /// [`POSITIVE_MIN`] for `positive` variables.
-    pub fn lower(&self) -> Option<f64> {
-        match (self.min, self.positive) {
-            (m, false) => m,
-            (Some(m), true) => Some(m.max(POSITIVE_MIN)),
-            (None, true) => Some(POSITIVE_MIN),
-        }
-    }
-
     pub fn dims(&self) -> Vec<Dim> {
         self.dimensions
             .iter()
@@ -189,16 +173,16 @@ impl Spec {
                     return Err(format!("{}: unknown enumeration type {t}", v.name));
                 }
             }
-            if let (Some(lo), Some(hi)) = (v.lower(), v.max) {
+            if let (Some(lo), Some(hi)) = (v.min, v.max) {
                 if lo > hi {
                     return Err(format!("{}: min {lo} is above max {hi}", v.name));
                 }
             }
-            if (v.min.is_some() || v.max.is_some() || v.positive) && !matches!(v.ty.as_str(), "Float64" | "UInt64") {
+            if (v.min.is_some() || v.max.is_some()) && !matches!(v.ty.as_str(), "Float64" | "UInt64") {
                 return Err(format!("{}: only Float64 and UInt64 variables have a range", v.name));
             }
             for x in v.start_numbers() {
-                if v.lower().is_some_and(|lo| x < lo) || v.max.is_some_and(|hi| x > hi) {
+                if v.min.is_some_and(|lo| x < lo) || v.max.is_some_and(|hi| x > hi) {
                     return Err(format!("{}: start value {x} is outside its range", v.name));
                 }
             }
@@ -363,7 +347,7 @@ impl Spec {
                 let t = &self.units.iter().find(|x| &x.name == u).unwrap().quantity;
                 let _ = write!(w, " declaredType=\"{}\"", esc(t));
             }
-            if let Some(m) = v.lower() {
+            if let Some(m) = v.min {
                 let _ = write!(w, " min=\"{}\"", number(&v.ty, m));
             }
             if let Some(m) = v.max {
@@ -523,7 +507,7 @@ impl Spec {
                 camel(&v.causality),
                 camel(&v.variability),
                 start.join(", "),
-                opt(v.lower()),
+                opt(v.min),
                 opt(v.max),
                 dims.join(", "),
                 enum_values.join(", ")

@@ -2,40 +2,10 @@
 //! stepped. Builds target/fmu/ModalMassSpring.fmu with `cargo xtask fmu`
 //! when it is missing or older than the sources.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
-use std::time::SystemTime;
+mod common;
 
 use fmi::fmi3::{import::Fmi3Import, CoSimulation, Common, Fmi3Model, GetSet};
 use fmi::traits::FmiImport;
-
-fn newest(dir: &Path) -> SystemTime {
-    let mut t = SystemTime::UNIX_EPOCH;
-    for e in std::fs::read_dir(dir).unwrap().flatten() {
-        let p = e.path();
-        let m = if p.is_dir() { newest(&p) } else { e.metadata().unwrap().modified().unwrap() };
-        t = t.max(m);
-    }
-    t
-}
-
-fn fmu() -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let target = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or(root.join("target"));
-    let fmu = target.join("fmu/ModalMassSpring.fmu");
-    let sources = ["src", "modelDescription", "xtask/src"].iter().map(|d| newest(&root.join(d))).max().unwrap();
-    let fresh = std::fs::metadata(&fmu).and_then(|m| m.modified()).is_ok_and(|t| t >= sources);
-    if !fresh {
-        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-        let status = Command::new(cargo).current_dir(root).args(["xtask", "fmu"]).status();
-        assert!(
-            status.is_ok_and(|s| s.success()),
-            "{} is missing or stale and `cargo xtask fmu` failed; run it by hand to see why",
-            fmu.display()
-        );
-    }
-    fmu
-}
 
 fn vr(import: &Fmi3Import, name: &str) -> u32 {
     import
@@ -49,7 +19,7 @@ fn vr(import: &Fmi3Import, name: &str) -> u32 {
 
 #[test]
 fn fmi_crate_imports_and_steps_the_fmu() {
-    let import: Fmi3Import = fmi::import::from_path(fmu()).expect("fmi crate loads the FMU");
+    let import: Fmi3Import = fmi::import::from_path(common::packed_fmu()).expect("fmi crate loads the FMU");
     let md = import.model_description();
     assert_eq!(md.fmi_version, "3.0");
     assert_eq!(md.model_name, "ModalMassSpring");

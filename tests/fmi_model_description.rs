@@ -172,23 +172,20 @@ fn ranges_of_the_xml_are_those_the_binary_enforces() {
         assert_eq!(attribute(&xml, v.name, "min"), v.min, "{}: min", v.name);
         assert_eq!(attribute(&xml, v.name, "max"), v.max, "{}: max", v.name);
     }
-    // Every numeric parameter has a range except gravity (any direction, any size).
-    let unbounded: Vec<&str> = VARIABLES
-        .iter()
-        .filter(|v| v.is_parameter() && matches!(v.ty, Type::Float64 | Type::UInt64) && v.min.is_none() && v.max.is_none())
-        .map(|v| v.name)
-        .collect();
-    assert_eq!(unbounded, ["gravity"]);
-    // Structural parameters are bounded on both sides (array sizes).
-    for v in VARIABLES.iter().filter(|v| v.causality == variables::Causality::StructuralParameter) {
-        assert!(v.min.is_some_and(|m| m >= 1.0) && v.max.is_some(), "{}", v.name);
+    // Every numeric parameter is bounded on both sides; array sizes from 1 up.
+    for v in VARIABLES.iter().filter(|v| v.is_parameter() && matches!(v.ty, Type::Float64 | Type::UInt64)) {
+        let (lo, hi) = (v.min.unwrap_or_else(|| panic!("{}: no min", v.name)), v.max.unwrap_or_else(|| panic!("{}: no max", v.name)));
+        assert!(lo.is_finite() && hi.is_finite() && lo < hi, "{}", v.name);
+        if v.causality == variables::Causality::StructuralParameter {
+            assert!(lo >= 1.0, "{}", v.name);
+        }
     }
 }
 
 #[test]
 fn a_start_value_outside_its_range_is_refused() {
     let text = std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("modelDescription/variables.toml")).unwrap();
-    let broken = text.replacen("start = 0.1\npositive = true", "start = 0.0\npositive = true", 1);
+    let broken = text.replacen("start = 0.1\nunit = \"m\"\nmin = 1e-6", "start = 0.0\nunit = \"m\"\nmin = 1e-6", 1);
     assert_ne!(broken, text);
     let e = generate::parse(&broken).unwrap_err();
     assert!(e.contains("spacing: start value 0 is outside its range"), "{e}");

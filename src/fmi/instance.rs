@@ -698,11 +698,7 @@ pub fn check_value(v: &Variable, x: Option<f64>) -> Result<(), String> {
     }
     if let Some(min) = v.min {
         if x < min {
-            return Err(if min == f64::MIN_POSITIVE {
-                format!("must be positive (min = {min:e})")
-            } else {
-                format!("below min = {min}")
-            });
+            return Err(format!("below min = {min}"));
         }
     }
     if let Some(max) = v.max {

@@ -54,8 +54,7 @@ pub struct Variable {
     /// are fitted by repeating the first element.
     pub start: &'static [f64],
     /// Range of the model description (inclusive), enforced by every setter,
-    /// by startValues.txt and by deserialization. Variables declared
-    /// `positive` have min = the smallest positive normal double.
+    /// by startValues.txt and by deserialization.
     pub min: Option<f64>,
     pub max: Option<f64>,
     pub dims: &'static [Dim],

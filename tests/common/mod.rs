@@ -4,8 +4,11 @@
 #![allow(dead_code, clippy::missing_safety_doc)]
 
 use std::ffi::{c_void, CStr, CString};
+use std::path::{Path, PathBuf};
+use std::process::Command;
 use std::ptr::{null, null_mut};
 use std::sync::Mutex;
+use std::time::SystemTime;
 
 use fmi_sys::fmi3::*;
 use modal_mass_spring::fmi::exports::*;
@@ -207,4 +210,34 @@ impl Drop for Fmu {
 
 pub fn bits(v: &[f64]) -> Vec<u64> {
     v.iter().map(|x| x.to_bits()).collect()
+}
+
+fn newest(dir: &Path) -> SystemTime {
+    let mut t = SystemTime::UNIX_EPOCH;
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        let m = if p.is_dir() { newest(&p) } else { e.metadata().unwrap().modified().unwrap() };
+        t = t.max(m);
+    }
+    t
+}
+
+/// target/fmu/ModalMassSpring.fmu (release build), made with `cargo xtask
+/// fmu` when it is missing or older than the sources.
+pub fn packed_fmu() -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let target = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or(root.join("target"));
+    let fmu = target.join("fmu/ModalMassSpring.fmu");
+    let sources = ["src", "modelDescription", "xtask/src"].iter().map(|d| newest(&root.join(d))).max().unwrap();
+    let fresh = std::fs::metadata(&fmu).and_then(|m| m.modified()).is_ok_and(|t| t >= sources);
+    if !fresh {
+        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+        let status = Command::new(cargo).current_dir(root).args(["xtask", "fmu"]).status();
+        assert!(
+            status.is_ok_and(|s| s.success()),
+            "{} is missing or stale and `cargo xtask fmu` failed; run it by hand to see why",
+            fmu.display()
+        );
+    }
+    fmu
 }

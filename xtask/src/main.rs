@@ -4,12 +4,16 @@
 //! - `run`    build the FMU and run the main job through fmpy (summary + plot)
 //! - `test`   every test: Rust (cargo test) and Python (pytest + fmpy)
 //! - `report` the error-against-run-time study into `report/` (`--quick`: small, for CI)
-//! - `setup`  install what the other tasks need (libclang, Python venv with fmpy)
+//! - `setup`  install what the other tasks need (libclang, valgrind, Python venv with fmpy)
+//! - `fuzz`   the cargo-fuzz targets for a bounded time (`--seconds N`)
+//! - `valgrind` leak check of instantiate/step/serialize/free cycles
 
 mod fmu;
+mod fuzz;
 mod report;
 mod run;
 mod setup;
+mod valgrind;
 
 use std::process::ExitCode;
 
@@ -25,8 +29,10 @@ fn main() -> ExitCode {
         "test" => run::test(rest),
         "report" => report::main(rest),
         "setup" => setup::main(rest),
+        "fuzz" => fuzz::main(rest),
+        "valgrind" => valgrind::main(rest),
         _ => {
-            eprintln!("usage: cargo xtask <fmu|run|test|report|setup> [options]");
+            eprintln!("usage: cargo xtask <fmu|run|test|report|setup|fuzz|valgrind> [options]");
             return ExitCode::from(2);
         }
     };

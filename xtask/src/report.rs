@@ -7,6 +7,12 @@ use std::process::Command;
 pub fn main(args: &[String]) -> Result<(), String> {
     let quick = args.iter().any(|a| a == "--quick");
     let out = args.iter().position(|a| a == "--out").and_then(|i| args.get(i + 1)).cloned().unwrap_or_else(|| "report".into());
+    run(quick, &out, &[])
+}
+
+/// The study with `cargo_args` added to its `cargo run` (`cargo xtask test`
+/// passes its own features, so the example reuses the test build).
+pub fn run(quick: bool, out: &str, cargo_args: &[&str]) -> Result<(), String> {
     let date = Command::new("date").arg("-u").arg("+%Y-%m-%d").output().ok().and_then(|o| String::from_utf8(o.stdout).ok()).unwrap_or_default();
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
@@ -15,7 +21,7 @@ pub fn main(args: &[String]) -> Result<(), String> {
     let root = crate::setup::root();
     let mut cmd = Command::new(env!("CARGO"));
     cmd.current_dir(&root);
-    cmd.args(["run", "--release", "--example", "report", "--", "--out", &out]);
+    cmd.args(["run", "--release", "--example", "report"]).args(cargo_args).args(["--", "--out", out]);
     if quick {
         cmd.arg("--quick");
     }

@@ -5,15 +5,23 @@
 //!   prints a summary and writes `out/default_scene.png`).
 //! - `test [PYTEST ARGS...]`: setup, build the default FMU and one scene-baked FMU
 //!   per canonical scene into `target/fmu/`, run `cargo test --release --workspace`
-//!   (with the XSD validation of the model description), then
-//!   pytest on `tests/python` with the venv's Python. Both suites always run;
-//!   the task fails if either fails.
+//!   (with the XSD validation of the model description and the soak run of a
+//!   million steps), the quick study, pytest on `tests/python` with the venv's
+//!   Python, the valgrind leak check, and each fuzz target for FUZZ_SECONDS.
+//!   Every stage always runs; the task fails if any fails.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use crate::{fmu, setup};
+use crate::{fmu, fuzz, setup, valgrind};
+
+/// Features of every cargo build of the test stage: the same for the tests,
+/// the quick study and the valgrind example, so each builds on the others.
+const TEST_FEATURES: [&str; 2] = ["--features", "modal_mass_spring/xsd"];
+
+/// Fuzzing time per target in `cargo xtask test` (CI): bounded, see README.
+const FUZZ_SECONDS: u64 = 30;
 
 fn target_dir(root: &Path) -> PathBuf {
     match std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from) {
@@ -137,7 +145,7 @@ pub fn test(args: &[String]) -> Result<(), String> {
     // Release profile: the FMUs above already built every dependency in it,
     // so the tests compile only themselves (the dev profile would build faer
     // a second time, most of CI's time).
-    let test_args = ["test", "--release", "--workspace", "--features", "modal_mass_spring/xsd"];
+    let test_args = ["test", "--release", "--workspace", TEST_FEATURES[0], TEST_FEATURES[1]];
     prepare_xsd(&root, &test_args)?;
     let status = Command::new(cargo())
         .current_dir(&root)
@@ -151,7 +159,7 @@ pub fn test(args: &[String]) -> Result<(), String> {
 
     step("cargo xtask report --quick");
     let report_dir = target_dir(&root).join("report-quick");
-    if let Err(e) = crate::report::main(&["--quick".to_string(), "--out".to_string(), report_dir.display().to_string()]) {
+    if let Err(e) = crate::report::run(true, &report_dir.display().to_string(), &TEST_FEATURES) {
         failures.push(format!("report --quick: {e}"));
     }
     lap("report --quick", &mut times);
@@ -175,11 +183,30 @@ pub fn test(args: &[String]) -> Result<(), String> {
         None => failures.push(format!("pytest was killed ({status})")),
     }
     lap("pytest", &mut times);
+
+    step("valgrind: cargo xtask valgrind");
+    if let Err(e) = valgrind::run(valgrind::DEFAULT_CYCLES, &TEST_FEATURES) {
+        failures.push(e);
+    }
+    lap("valgrind", &mut times);
+
+    step(&format!("fuzzing: cargo xtask fuzz --seconds {FUZZ_SECONDS}"));
+    let targets: Vec<String> = Vec::new();
+    match fuzz::run(&targets, FUZZ_SECONDS, false) {
+        Ok(reports) => {
+            for r in reports {
+                eprintln!("fuzz {}: {} executions in {:.0} s, no crash", r.target, r.runs, r.seconds);
+            }
+        }
+        Err(e) => failures.push(e),
+    }
+    lap("fuzz", &mut times);
+
     let summary: Vec<String> = times.iter().map(|(n, t)| format!("{n} {t:.0} s")).collect();
     eprintln!("\ntimes: {}", summary.join(", "));
 
     if failures.is_empty() {
-        eprintln!("\nall tests passed (cargo test and pytest)");
+        eprintln!("\nall tests passed (cargo test, pytest, valgrind, fuzzing)");
         Ok(())
     } else {
         Err(format!("failed: {}", failures.join("; ")))

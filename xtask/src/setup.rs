@@ -1,9 +1,11 @@
 //! `cargo xtask setup`: installs what the other tasks need, and only what is
 //! missing, so it is cheap to run again.
 //!
-//! - Debian packages: `libclang-dev` (bindgen in `fmi-sys`) and `libxml2-dev`
-//!   (XSD validation in `fmi-rs`), through apt-get (`apt-get update` once,
-//!   only when something has to be installed).
+//! - Debian packages: `libclang-dev` (bindgen in `fmi-sys`), `libxml2-dev`
+//!   (XSD validation in `fmi-rs`), `valgrind` (`cargo xtask valgrind`) and
+//!   `libclang-rt-dev` (the libFuzzer runtime `cargo xtask fuzz` links),
+//!   through apt-get (`apt-get update` once, only when something has to be
+//!   installed).
 //! - The Python environment `.venv` in the repository root, with fmpy, pytest,
 //!   numpy and matplotlib.
 
@@ -11,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 /// Debian packages the Rust build and tests need.
-const DEBIAN_PACKAGES: &[&str] = &["libclang-dev", "libxml2-dev"];
+const DEBIAN_PACKAGES: &[&str] = &["libclang-dev", "libxml2-dev", "valgrind", "libclang-rt-dev"];
 
 /// Python packages: (distribution name as pip knows it, requirement to install).
 const PYTHON_PACKAGES: &[(&str, &str)] = &[

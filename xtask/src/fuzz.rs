@@ -1,0 +1,164 @@
+//! `cargo xtask fuzz [--seconds N] [--linked] [TARGET...]`: runs the
+//! cargo-fuzz targets of `fuzz/` for N seconds each (default 30) and reports
+//! the executions; fails on any crash, sanitizer report or failed check.
+//!
+//! - Installs cargo-fuzz (`cargo install cargo-fuzz --locked`) if missing and
+//!   runs it with RUSTC_BOOTSTRAP=1 (it needs nightly flags).
+//! - By default the targets load the FMU's release library
+//!   (`target/release/libmodal_mass_spring.so`, built here if needed) with
+//!   AddressSanitizer in the harness: a build of seconds. `--linked` builds
+//!   the FMU crate into the targets, coverage-instrumented, without a
+//!   sanitizer (an ASan build of faer takes far longer): minutes to build,
+//!   deeper runs.
+//! - Links the system libFuzzer (Debian's libclang-rt-dev) when present,
+//!   instead of compiling libFuzzer's C++ sources.
+//! - Inputs that fail are left in `fuzz/artifacts/TARGET/`; the corpus grows
+//!   in `fuzz/corpus/TARGET/` from the seeds in `fuzz/seeds/TARGET/`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::Instant;
+
+use crate::setup;
+
+const TARGETS: &[&str] = &["deserialize", "call_sequence"];
+const DEFAULT_SECONDS: u64 = 30;
+
+pub struct Report {
+    pub target: String,
+    pub runs: u64,
+    pub seconds: f64,
+}
+
+pub fn main(args: &[String]) -> Result<(), String> {
+    let mut seconds = DEFAULT_SECONDS;
+    let mut linked = false;
+    let mut targets: Vec<String> = Vec::new();
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--seconds" => {
+                let v = it.next().ok_or("--seconds needs a value")?;
+                seconds = v.parse().map_err(|_| format!("--seconds: not a number: {v}"))?;
+            }
+            "--linked" => linked = true,
+            "-h" | "--help" => return Err("usage: cargo xtask fuzz [--seconds N] [--linked] [TARGET...]".into()),
+            t if TARGETS.contains(&t) => targets.push(t.to_string()),
+            other => return Err(format!("unknown option or target {other} (targets: {})", TARGETS.join(", "))),
+        }
+    }
+    let reports = run(&targets, seconds, linked)?;
+    for r in &reports {
+        println!("fuzz {}: {} executions in {:.0} s, no crash", r.target, r.runs, r.seconds);
+    }
+    Ok(())
+}
+
+fn cargo() -> String {
+    std::env::var("CARGO").unwrap_or_else(|_| "cargo".into())
+}
+
+fn ensure_cargo_fuzz() -> Result<(), String> {
+    let ok = Command::new(cargo()).args(["fuzz", "--version"]).stdout(Stdio::null()).stderr(Stdio::null()).status();
+    if ok.map(|s| s.success()).unwrap_or(false) {
+        return Ok(());
+    }
+    eprintln!("fuzz: installing cargo-fuzz");
+    let status = Command::new(cargo())
+        .args(["install", "cargo-fuzz", "--locked"])
+        .status()
+        .map_err(|e| format!("cannot run cargo install: {e}"))?;
+    if !status.success() {
+        return Err("cargo install cargo-fuzz --locked failed".into());
+    }
+    Ok(())
+}
+
+/// The libFuzzer runtime of the system's clang, if installed.
+fn system_libfuzzer() -> Option<PathBuf> {
+    let mut found: Vec<PathBuf> = std::fs::read_dir("/usr/lib")
+        .ok()?
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().starts_with("llvm-"))
+        .flat_map(|e| std::fs::read_dir(e.path().join("lib/clang")).into_iter().flatten().flatten())
+        .map(|v| v.path().join("lib/linux/libclang_rt.fuzzer-x86_64.a"))
+        .filter(|p| p.exists())
+        .collect();
+    found.sort();
+    found.pop()
+}
+
+fn target_dir(root: &Path) -> PathBuf {
+    match std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from) {
+        Some(p) if p.is_absolute() => p,
+        Some(p) => root.join(p),
+        None => root.join("target"),
+    }
+}
+
+/// Executions and seconds from libFuzzer's "Done 12345 runs in 30 second(s)".
+fn executions(log: &str) -> Option<(u64, f64)> {
+    log.lines().rev().find_map(|l| {
+        let w: Vec<&str> = l.strip_prefix("Done ")?.split_whitespace().collect();
+        Some((w.first()?.parse().ok()?, w.get(3)?.parse().ok()?))
+    })
+}
+
+/// Runs `targets` (every target when empty) for `seconds` each.
+pub fn run(targets: &[String], seconds: u64, linked: bool) -> Result<Vec<Report>, String> {
+    let all: Vec<String> = TARGETS.iter().map(|t| t.to_string()).collect();
+    let targets = if targets.is_empty() { &all[..] } else { targets };
+    let root = setup::root();
+    let fuzz = root.join("fuzz");
+    ensure_cargo_fuzz()?;
+    let library = target_dir(&root).join("release/libmodal_mass_spring.so");
+    if !linked {
+        let status = Command::new(cargo())
+            .current_dir(&root)
+            .args(["build", "--release", "--lib", "--package", "modal_mass_spring"])
+            .status()
+            .map_err(|e| format!("cannot run cargo: {e}"))?;
+        if !status.success() {
+            return Err("cargo build --release --lib failed".into());
+        }
+    }
+    let (sanitizer, features): (&str, &[&str]) = if linked { ("none", &["--features", "linked"]) } else { ("address", &[]) };
+    let libfuzzer = system_libfuzzer();
+    let mut reports = Vec::new();
+    for t in targets {
+        let corpus = fuzz.join("corpus").join(t);
+        std::fs::create_dir_all(&corpus).map_err(|e| format!("{}: {e}", corpus.display()))?;
+        let seeds = fuzz.join("seeds").join(t);
+        let mut cmd = Command::new(cargo());
+        cmd.current_dir(&fuzz)
+            .env("RUSTC_BOOTSTRAP", "1")
+            .env("MMS_FMU_LIBRARY", &library)
+            .args(["fuzz", "run", "--sanitizer", sanitizer])
+            .args(features)
+            .arg(t)
+            .arg(&corpus);
+        if seeds.is_dir() {
+            cmd.arg(&seeds);
+        }
+        // A step is at most 0.1 s of model time; anything near the timeout is a hang.
+        cmd.args(["--", &format!("-max_total_time={seconds}"), "-timeout=20", "-max_len=4096", "-print_final_stats=1"]);
+        if let Some(lib) = &libfuzzer {
+            cmd.env("CUSTOM_LIBFUZZER_PATH", lib);
+        }
+        eprintln!("\n==> fuzz {t} ({seconds} s{})", if linked { ", linked" } else { "" });
+        let start = Instant::now();
+        let out = cmd.stderr(Stdio::piped()).output().map_err(|e| format!("cannot run cargo fuzz: {e}"))?;
+        let log = String::from_utf8_lossy(&out.stderr);
+        let tail: Vec<&str> = log.lines().rev().take(60).collect::<Vec<_>>().into_iter().rev().collect();
+        if !out.status.success() {
+            eprintln!("{}", tail.join("\n"));
+            return Err(format!("fuzz target {t} failed ({}); the input is in fuzz/artifacts/{t}/", out.status));
+        }
+        let (runs, fuzzing) = executions(&log).ok_or_else(|| format!("fuzz target {t}: no execution count in its output:\n{}", tail.join("\n")))?;
+        let stats: Vec<&str> = log.lines().filter(|l| l.starts_with("stat::")).collect();
+        eprintln!("{}", stats.join("\n"));
+        eprintln!("fuzz {t}: {runs} executions in {fuzzing:.0} s of fuzzing ({:.0} s with the build), no crash", start.elapsed().as_secs_f64());
+        reports.push(Report { target: t.clone(), runs, seconds: fuzzing });
+    }
+    Ok(reports)
+}

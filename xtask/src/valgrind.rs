@@ -1,0 +1,57 @@
+//! `cargo xtask valgrind [CYCLES]`: the `fmi_cycles` example (instantiate,
+//! configure, step, FMU states, serialization, refused calls, free, over and
+//! over, through the C functions) under
+//! `valgrind --leak-check=full --error-exitcode=1`; fails on any leak or
+//! invalid memory access.
+
+use std::process::Command;
+
+use crate::setup;
+
+pub const DEFAULT_CYCLES: &str = "12";
+
+pub fn main(args: &[String]) -> Result<(), String> {
+    let cycles = match args {
+        [] => DEFAULT_CYCLES.to_string(),
+        [n] if n.parse::<u32>().is_ok() => n.clone(),
+        _ => return Err("usage: cargo xtask valgrind [CYCLES]".into()),
+    };
+    run(&cycles, &[])
+}
+
+/// `cycles` cycles under valgrind, the example built with `cargo_args` added
+/// (`cargo xtask test` passes its own features, so the test build is reused).
+pub fn run(cycles: &str, cargo_args: &[&str]) -> Result<(), String> {
+    let root = setup::root();
+    if Command::new("valgrind").arg("--version").output().is_err() {
+        return Err("valgrind is not installed (cargo xtask setup installs it)".into());
+    }
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    // The release profile, as the FMU is built (and with no second build of faer).
+    let out = Command::new(&cargo)
+        .current_dir(&root)
+        .args(["build", "--release", "--example", "fmi_cycles", "--message-format=json-render-diagnostics"])
+        .args(cargo_args)
+        .output()
+        .map_err(|e| format!("cannot run cargo: {e}"))?;
+    if !out.status.success() {
+        return Err(format!("cargo build --example fmi_cycles failed:\n{}", String::from_utf8_lossy(&out.stderr)));
+    }
+    let exe = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter(|l| l.contains("\"name\":\"fmi_cycles\"") && l.contains("\"executable\":\""))
+        .find_map(|l| Some(l.split("\"executable\":\"").nth(1)?.split('"').next()?.to_string()))
+        .ok_or("cargo did not report the fmi_cycles executable")?;
+    let status = Command::new("valgrind")
+        .args(["--leak-check=full", "--show-leak-kinds=definite,indirect,possible", "--errors-for-leak-kinds=definite,indirect,possible"])
+        .args(["--error-exitcode=1", "--quiet"])
+        .arg(&exe)
+        .arg(cycles)
+        .status()
+        .map_err(|e| format!("cannot run valgrind: {e}"))?;
+    if !status.success() {
+        return Err(format!("valgrind found leaks or memory errors in fmi_cycles ({status})"));
+    }
+    println!("valgrind: fmi_cycles, {cycles} cycles: no leaks, no memory errors");
+    Ok(())
+}
