@@ -5,11 +5,13 @@
 //! (Rayleigh, K0 the stiffness at x*, so the modal and full runs share one
 //! damping model). Linear systems (the implicit Newton matrix, and the
 //! explicit velocity update when beta > 0) are solved with faer's sparse
-//! Cholesky; its symbolic analysis and every buffer are made once.
+//! Cholesky LL^T, or LDL^T where compressed springs make the Newton matrix
+//! indefinite; the symbolic analysis and every buffer are made once.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, SymbolicCholesky, SymmetricOrdering};
+use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LdltRef, LltRef, SymbolicCholesky, SymmetricOrdering};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
@@ -45,6 +47,8 @@ pub struct FullSolver {
     matrix: Vec<f64>,
     symbolic: SymbolicCholesky<usize>,
     l_values: Vec<f64>,
+    /// `l_values` holds LDL^T (the matrix was indefinite), not LL^T.
+    indefinite: bool,
     mem: MemBuffer,
     /// (dt, alpha, beta) for which `l_values` holds M + dt/2 C (explicit, beta > 0).
     explicit_factor: Option<(f64, f64, f64)>,
@@ -57,8 +61,9 @@ impl FullSolver {
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx);
         let symbolic = factorize_symbolic_cholesky(sym, Side::Upper, SymmetricOrdering::Amd, Default::default())
             .map_err(|e| SimError { message: format!("sparse Cholesky analysis failed: {e:?}") })?;
-        let req = StackReq::all_of(&[
+        let req = StackReq::any_of(&[
             symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
+            symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
             symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
         ]);
         let l_values = vec![0.0; symbolic.len_val()];
@@ -83,6 +88,7 @@ impl FullSolver {
             matrix: vec![0.0; nnz],
             symbolic,
             l_values,
+            indefinite: false,
             mem: MemBuffer::new(req),
             explicit_factor: None,
             length_scale: 0.0,
@@ -156,20 +162,34 @@ impl FullSolver {
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.pattern.col_ptr, None, &self.pattern.row_idx);
         let a = SparseColMatRef::new(sym, &self.matrix);
         let stack = MemStack::new(&mut self.mem);
+        let llt = self.symbolic.factorize_numeric_llt(&mut self.l_values, a, Side::Upper, LltRegularization::default(), Par::Seq, stack, Default::default());
+        self.indefinite = llt.is_err();
+        if !self.indefinite {
+            return Ok(());
+        }
+        // Springs in compression have negative transverse stiffness; with
+        // stiff springs it can outweigh M / (beta dt^2). Newton still
+        // converges on the indefinite matrix: factor it as LDL^T.
+        let stack = MemStack::new(&mut self.mem);
+        let regularization = LdltRegularization { dynamic_regularization_signs: None, dynamic_regularization_delta: 0.0, dynamic_regularization_epsilon: 0.0 };
         self.symbolic
-            .factorize_numeric_llt(&mut self.l_values, a, Side::Upper, LltRegularization::default(), Par::Seq, stack, Default::default())
+            .factorize_numeric_ldlt(&mut self.l_values, a, Side::Upper, regularization, Par::Seq, stack, Default::default())
             .map(|_| ())
             .map_err(|_| SimError {
-                message: "full-space Newmark matrix is not positive definite (springs in compression buckle); reduce maxInternalStep".into(),
+                message: "full-space Newmark matrix is singular (springs in compression buckle); reduce maxInternalStep".into(),
             })
     }
 
     /// Solves with the last factorization, in place.
     fn solve(&mut self, rhs: &mut [f64]) {
         let n = rhs.len();
-        let llt = LltRef::<usize, f64>::new(&self.symbolic, &self.l_values);
         let stack = MemStack::new(&mut self.mem);
-        llt.solve_in_place_with_conj(Conj::No, MatMut::from_column_major_slice_mut(rhs, n, 1), Par::Seq, stack);
+        let rhs = MatMut::from_column_major_slice_mut(rhs, n, 1);
+        if self.indefinite {
+            LdltRef::<usize, f64>::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+        } else {
+            LltRef::<usize, f64>::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+        }
     }
 
     pub fn step_explicit(&mut self, scene: &Scene, dt: f64) -> Result<(), SimError> {

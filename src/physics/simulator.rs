@@ -41,6 +41,11 @@ pub struct Snapshot {
 pub const EXPLICIT_SAFETY: f64 = 0.9;
 /// Internal steps one communication step may take before it is refused.
 pub const MAX_INTERNAL_STEPS_PER_CALL: usize = 10_000_000;
+/// Explicit internal steps one `maxInternalStep` may be split into before
+/// set-up refuses the explicit integrator: beyond it the scene is too stiff
+/// for it (the implicit integrator takes `maxInternalStep` in one step), unless
+/// the host asked for steps that short by lowering `maxInternalStep`.
+pub const MAX_EXPLICIT_SUBSTEPS: f64 = 1e4;
 /// Above this many modes the explicit limit uses the full-space bound instead
 /// of the eigenvalues of the reduced taut stiffness.
 const DENSE_BOUND_MODES: usize = 64;
@@ -89,7 +94,11 @@ impl Simulator {
             return err(format!("maxInternalStep must be finite and positive, got {}", solver.max_internal_step));
         }
         if scene.n_dofs() == 0 {
-            return err("every node is fixed: the scene has no free degree of freedom".into());
+            return err(format!(
+                "ny = {} (nx = {}) leaves no free node under fixedNodes: the scene has no free degree of freedom; \
+                 it needs ny >= 2 (or nx >= 3 with top-corners)",
+                scene_params.ny, scene_params.nx
+            ));
         }
         if solver.reduction == Reduction::Modal && solver.n_modes == 0 {
             return err("nModes must be at least 1 with reduction = modal".into());
@@ -141,8 +150,38 @@ impl Simulator {
             fall_scale,
             total_mass,
         };
+        sim.check_explicit_cost(scene_params)?;
         sim.refresh_outputs();
         Ok(sim)
+    }
+
+    /// Refuses an explicit run whose stability limit would split every
+    /// `maxInternalStep` into more than MAX_EXPLICIT_SUBSTEPS internal steps,
+    /// naming what sets the limit and what would lift it.
+    fn check_explicit_cost(&self, p: &SceneParams) -> Result<(), SimError> {
+        if self.solver.integrator != Integrator::NewmarkExplicit || !self.solver.substepping {
+            return Ok(());
+        }
+        let dt = self.max_stable_step();
+        let per_step = self.solver.max_internal_step / dt;
+        if per_step <= MAX_EXPLICIT_SUBSTEPS {
+            return Ok(());
+        }
+        let kept = match self.model {
+            Model::Modal(_) => format!("the {} kept modes", self.solver.n_modes),
+            Model::Full(_) => "full space".to_string(),
+        };
+        err(format!(
+            "integrator = newmark-explicit is stable here only with internal steps of {dt:.3e} s \
+             (highest frequency {:.3e} rad/s of {kept}, springStiffness / nodeMass = {:.3e} 1/s^2), \
+             {per_step:.2e} of them per maxInternalStep = {} s (limit {MAX_EXPLICIT_SUBSTEPS:e}): \
+             use integrator = newmark-implicit, fewer modes (nModes), \
+             or set maxInternalStep to {:.3e} s or less to accept steps that short",
+            self.omega_sq_bound.sqrt(),
+            p.spring_stiffness.max(p.aux_stiffness) / p.node_mass,
+            self.solver.max_internal_step,
+            dt * MAX_EXPLICIT_SUBSTEPS,
+        ))
     }
 
     /// Largest internal step: `maxInternalStep`, and for the explicit

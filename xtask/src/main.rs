@@ -7,12 +7,14 @@
 //! - `setup`  install what the other tasks need (libclang, valgrind, Python venv with fmpy)
 //! - `fuzz`   the cargo-fuzz targets for a bounded time (`--seconds N`)
 //! - `valgrind` leak check of instantiate/step/serialize/free cycles
+//! - `stability` the stability matrix, its table written into the README
 
 mod fmu;
 mod fuzz;
 mod report;
 mod run;
 mod setup;
+mod stability;
 mod valgrind;
 
 use std::process::ExitCode;
@@ -31,8 +33,9 @@ fn main() -> ExitCode {
         "setup" => setup::main(rest),
         "fuzz" => fuzz::main(rest),
         "valgrind" => valgrind::main(rest),
+        "stability" => stability::main(rest),
         _ => {
-            eprintln!("usage: cargo xtask <fmu|run|test|report|setup|fuzz|valgrind> [options]");
+            eprintln!("usage: cargo xtask <fmu|run|test|report|setup|fuzz|valgrind|stability> [options]");
             return ExitCode::from(2);
         }
     };

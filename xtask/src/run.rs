@@ -6,8 +6,8 @@
 //! - `test [PYTEST ARGS...]`: setup, build the default FMU and one scene-baked FMU
 //!   per canonical scene into `target/fmu/`, run `cargo test --release --workspace`
 //!   (with the XSD validation of the model description and the soak run of a
-//!   million steps), the quick study, pytest on `tests/python` with the venv's
-//!   Python, the valgrind leak check, and each fuzz target for FUZZ_SECONDS.
+//!   million steps), each fuzz target for FUZZ_SECONDS, the quick study,
+//!   pytest on `tests/python` with the venv's Python and the valgrind leak check.
 //!   Every stage always runs; the task fails if any fails.
 
 use std::path::{Path, PathBuf};
@@ -16,9 +16,10 @@ use std::time::Instant;
 
 use crate::{fmu, fuzz, setup, valgrind};
 
-/// Features of every cargo build of the test stage: the same for the tests,
-/// the quick study and the valgrind example, so each builds on the others.
-const TEST_FEATURES: [&str; 2] = ["--features", "modal_mass_spring/xsd"];
+/// Packages and features of every cargo build of the test stage: the same
+/// for the tests, the quick study and the valgrind example, so each builds
+/// on the others (features are unified over the packages a build selects).
+const TEST_CARGO_ARGS: [&str; 3] = ["--workspace", "--features", "modal_mass_spring/xsd"];
 
 /// Fuzzing time per target in `cargo xtask test` (CI): bounded, see README.
 const FUZZ_SECONDS: u64 = 30;
@@ -141,11 +142,25 @@ pub fn test(args: &[String]) -> Result<(), String> {
 
     let mut failures = Vec::new();
 
+    // Right after the FMU build: the fuzz targets load its library as it is
+    // (the test build below compiles the crate with other features).
+    step(&format!("fuzzing: cargo xtask fuzz --seconds {FUZZ_SECONDS}"));
+    let targets: Vec<String> = Vec::new();
+    match fuzz::run(&targets, FUZZ_SECONDS, false) {
+        Ok(reports) => {
+            for r in reports {
+                eprintln!("fuzz {}: {} executions in {:.0} s, no crash", r.target, r.runs, r.seconds);
+            }
+        }
+        Err(e) => failures.push(e),
+    }
+    lap("fuzz", &mut times);
+
     step("cargo test --release --workspace --features xsd");
     // Release profile: the FMUs above already built every dependency in it,
     // so the tests compile only themselves (the dev profile would build faer
     // a second time, most of CI's time).
-    let test_args = ["test", "--release", "--workspace", TEST_FEATURES[0], TEST_FEATURES[1]];
+    let test_args = ["test", "--release", TEST_CARGO_ARGS[0], TEST_CARGO_ARGS[1], TEST_CARGO_ARGS[2]];
     prepare_xsd(&root, &test_args)?;
     let status = Command::new(cargo())
         .current_dir(&root)
@@ -159,7 +174,7 @@ pub fn test(args: &[String]) -> Result<(), String> {
 
     step("cargo xtask report --quick");
     let report_dir = target_dir(&root).join("report-quick");
-    if let Err(e) = crate::report::run(true, &report_dir.display().to_string(), &TEST_FEATURES) {
+    if let Err(e) = crate::report::run(true, &report_dir.display().to_string(), &TEST_CARGO_ARGS) {
         failures.push(format!("report --quick: {e}"));
     }
     lap("report --quick", &mut times);
@@ -185,22 +200,10 @@ pub fn test(args: &[String]) -> Result<(), String> {
     lap("pytest", &mut times);
 
     step("valgrind: cargo xtask valgrind");
-    if let Err(e) = valgrind::run(valgrind::DEFAULT_CYCLES, &TEST_FEATURES) {
+    if let Err(e) = valgrind::run(valgrind::DEFAULT_CYCLES, &TEST_CARGO_ARGS) {
         failures.push(e);
     }
     lap("valgrind", &mut times);
-
-    step(&format!("fuzzing: cargo xtask fuzz --seconds {FUZZ_SECONDS}"));
-    let targets: Vec<String> = Vec::new();
-    match fuzz::run(&targets, FUZZ_SECONDS, false) {
-        Ok(reports) => {
-            for r in reports {
-                eprintln!("fuzz {}: {} executions in {:.0} s, no crash", r.target, r.runs, r.seconds);
-            }
-        }
-        Err(e) => failures.push(e),
-    }
-    lap("fuzz", &mut times);
 
     let summary: Vec<String> = times.iter().map(|(n, t)| format!("{n} {t:.0} s")).collect();
     eprintln!("\ntimes: {}", summary.join(", "));

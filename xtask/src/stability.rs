@@ -1,0 +1,22 @@
+//! `cargo xtask stability`: runs the stability matrix (tests/stability.rs)
+//! and writes its table into the README, between the markers the test
+//! checks on every other run.
+
+use std::process::Command;
+
+pub fn main(args: &[String]) -> Result<(), String> {
+    if !args.is_empty() {
+        return Err("usage: cargo xtask stability".into());
+    }
+    let status = Command::new(env!("CARGO"))
+        .current_dir(crate::setup::root())
+        .args(["test", "--release", "--test", "stability", "--", "--nocapture"])
+        .env("MMS_STABILITY_WRITE", "1")
+        .status()
+        .map_err(|e| format!("cannot run cargo: {e}"))?;
+    if !status.success() {
+        return Err("the stability matrix failed (the README's table was written only if every cell passed its checks)".into());
+    }
+    println!("README.md: stability table written (the full output is in target/stability.md)");
+    Ok(())
+}
