@@ -46,6 +46,22 @@ fn parse(args: &[String]) -> Result<Options, String> {
     Ok(o)
 }
 
+/// Builds the FMU's shared library (release, the product's features only)
+/// and returns its path.
+pub fn build_library(root: &Path) -> Result<PathBuf, String> {
+    let target = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or(root.join("target"));
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let status = Command::new(cargo)
+        .current_dir(root)
+        .args(["build", "--release", "--lib", "--package", "modal_mass_spring"])
+        .status()
+        .map_err(|e| format!("cannot run cargo: {e}"))?;
+    if !status.success() {
+        return Err("cargo build --release --lib failed".into());
+    }
+    Ok(target.join("release/libmodal_mass_spring.so"))
+}
+
 pub fn main(args: &[String]) -> Result<(), String> {
     let o = parse(args)?;
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf();
@@ -83,17 +99,8 @@ pub fn main(args: &[String]) -> Result<(), String> {
     let html = spec.documentation_html(&overrides, &title)?;
     let starts = spec.start_values_text(&overrides)?;
 
+    let lib = build_library(&root)?;
     let target = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or(root.join("target"));
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
-        .current_dir(&root)
-        .args(["build", "--release", "--lib", "--package", "modal_mass_spring"])
-        .status()
-        .map_err(|e| format!("cannot run cargo: {e}"))?;
-    if !status.success() {
-        return Err("cargo build --release --lib failed".into());
-    }
-    let lib = target.join("release/libmodal_mass_spring.so");
     let binary = std::fs::read(&lib).map_err(|e| format!("{}: {e}", lib.display()))?;
 
     let out = o.out.clone().unwrap_or_else(|| {

@@ -111,17 +111,7 @@ pub fn run(targets: &[String], seconds: u64, linked: bool) -> Result<Vec<Report>
     let root = setup::root();
     let fuzz = root.join("fuzz");
     ensure_cargo_fuzz()?;
-    let library = target_dir(&root).join("release/libmodal_mass_spring.so");
-    if !linked {
-        let status = Command::new(cargo())
-            .current_dir(&root)
-            .args(["build", "--release", "--lib", "--package", "modal_mass_spring"])
-            .status()
-            .map_err(|e| format!("cannot run cargo: {e}"))?;
-        if !status.success() {
-            return Err("cargo build --release --lib failed".into());
-        }
-    }
+    let library = if linked { target_dir(&root).join("release/libmodal_mass_spring.so") } else { crate::fmu::build_library(&root)? };
     let (sanitizer, features): (&str, &[&str]) = if linked { ("none", &["--features", "linked"]) } else { ("address", &[]) };
     let libfuzzer = system_libfuzzer();
     let mut reports = Vec::new();
