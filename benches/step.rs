@@ -81,7 +81,8 @@ fn do_step(c: &mut Criterion) {
 
     // The default FMU (this scene, explicit, r = 2) with the same internal step.
     let (name_c, token) = (CString::new("bench").unwrap(), CString::new(INSTANTIATION_TOKEN).unwrap());
-    let inst = unsafe { fmi3InstantiateCoSimulation(name_c.as_ptr(), token.as_ptr(), null(), false, false, false, false, null(), 0, null_mut(), Some(silent), None) };
+    let inst =
+        unsafe { fmi3InstantiateCoSimulation(name_c.as_ptr(), token.as_ptr(), null(), false, false, false, false, null(), 0, null_mut(), Some(silent), None) };
     assert!(!inst.is_null());
     unsafe {
         assert_eq!(fmi3SetFloat64(inst, &vr::MAX_INTERNAL_STEP, 1, &dt, 1), fmi3Status_fmi3OK);

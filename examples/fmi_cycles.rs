@@ -115,8 +115,5 @@ fn main() {
     for i in 0..cycles {
         unsafe { cycle(i, &mut counts) };
     }
-    println!(
-        "fmi_cycles: {cycles} cycles; messages logged: {} ok, {} discard, {} error",
-        counts[0], counts[2], counts[3]
-    );
+    println!("fmi_cycles: {cycles} cycles; messages logged: {} ok, {} discard, {} error", counts[0], counts[2], counts[3]);
 }

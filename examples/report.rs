@@ -13,6 +13,11 @@ use modal_mass_spring::physics::*;
 
 /// Output times are multiples of this; every co-simulation step divides it.
 const FRAME: f64 = 0.05;
+/// How much smaller than every error it measures the reference's own error
+/// (against its run at half the step) must be. Where the trajectory itself is
+/// sensitive, that own error stops shrinking with dt from some time on;
+/// `error_resolved` is E over the window before that.
+const REFERENCE_MARGIN: f64 = 10.0;
 const STEPS: [(f64, &str); 3] = [(1.0 / 1000.0, "1/1000"), (1.0 / 240.0, "1/240"), (1.0 / 60.0, "1/60")];
 
 struct SceneCase {
@@ -36,6 +41,9 @@ struct Row {
     stable: bool,
     /// E of this run against the full-space run with the same integrator and step.
     vs_full: f64,
+    /// E over the output times up to `resolved_until_s` (see [`REFERENCE_MARGIN`]).
+    error_resolved: f64,
+    resolved_until_s: f64,
     note: String,
 }
 
@@ -94,6 +102,20 @@ fn error(run: &[Vec<f64>], reference: &[Vec<f64>], d: usize) -> (f64, f64) {
         }
     }
     ((num / den).sqrt(), max_node)
+}
+
+/// E over growing windows: element k - 1 is E over the first k output times
+/// (NaN for k = 1, where the reference has not moved yet).
+fn errors_by_window(run: &[Vec<f64>], reference: &[Vec<f64>]) -> Vec<f64> {
+    let (mut num, mut den) = (0.0, 0.0);
+    run.iter()
+        .zip(reference)
+        .map(|(x, xr)| {
+            num += x.iter().zip(xr).map(|(a, b)| (a - b).powi(2)).sum::<f64>();
+            den += xr.iter().zip(&reference[0]).map(|(a, b)| (a - b).powi(2)).sum::<f64>();
+            (num / den).sqrt()
+        })
+        .collect()
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -156,7 +178,10 @@ fn main() {
                     // springs x r^2 x 30 flops per iteration; beyond
                     // IMPLICIT_TANGENT_LIMIT a single step takes seconds.
                     let note = if integrator == Integrator::NewmarkImplicit && (springs * r * r) as f64 > IMPLICIT_TANGENT_LIMIT {
-                        format!("not run: the reduced tangent needs springs x r^2 = {:.1e} > {IMPLICIT_TANGENT_LIMIT:.0e} per Newton iteration", (springs * r * r) as f64)
+                        format!(
+                            "not run: the reduced tangent needs springs x r^2 = {:.1e} > {IMPLICIT_TANGENT_LIMIT:.0e} per Newton iteration",
+                            (springs * r * r) as f64
+                        )
                     } else {
                         String::new()
                     };
@@ -176,7 +201,7 @@ fn main() {
         }
         plans.push((ci, list));
     }
-    let total: usize = plans.iter().map(|(_, l)| l.len() + 2).sum();
+    let total: usize = plans.iter().map(|(_, l)| l.len() + 3).sum();
     let bar = ProgressBar::new(total as u64);
     bar.set_style(ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {msg}").unwrap().progress_chars("=> "));
 
@@ -191,9 +216,17 @@ fn main() {
         let reference = simulate(p, &full(Integrator::NewmarkExplicit, reference_dt), reference_dt, seconds, f64::INFINITY).expect("reference run failed");
         bar.inc(1);
         bar.set_message(format!("{}: reference at half the step", case.label));
-        let halved = simulate(p, &full(Integrator::NewmarkExplicit, reference_dt / 2.0), reference_dt / 2.0, seconds, f64::INFINITY).expect("reference check failed");
+        let halved =
+            simulate(p, &full(Integrator::NewmarkExplicit, reference_dt / 2.0), reference_dt / 2.0, seconds, f64::INFINITY).expect("reference check failed");
+        bar.inc(1);
+        bar.set_message(format!("{}: reference at a quarter of the step", case.label));
+        let quartered =
+            simulate(p, &full(Integrator::NewmarkExplicit, reference_dt / 4.0), reference_dt / 4.0, seconds, f64::INFINITY).expect("reference check failed");
         bar.inc(1);
         let (self_error, _) = error(&reference.frames, &halved.frames, p.dimension);
+        let (halved_error, _) = error(&halved.frames, &quartered.frames, p.dimension);
+        let self_by_window = errors_by_window(&reference.frames, &halved.frames);
+        let mut run_by_window: Vec<Vec<f64>> = Vec::new();
         let first = rows.len();
         // Full-space trajectories by (integrator, step), for the vs_full column.
         let mut full_runs: Vec<(Integrator, String, Vec<Vec<f64>>)> = Vec::new();
@@ -239,6 +272,8 @@ fn main() {
                 max_node_error: f64::NAN,
                 stable: false,
                 vs_full: f64::NAN,
+                error_resolved: f64::NAN,
+                resolved_until_s: f64::NAN,
                 note: plan.note.clone(),
             };
             match last.unwrap() {
@@ -249,6 +284,7 @@ fn main() {
                     row.run_s_per_sim_s = median(times);
                     row.error = e;
                     row.max_node_error = m;
+                    run_by_window.push(errors_by_window(&t.frames, &reference.frames));
                     row.stable = e.is_finite();
                     if method == "full" && plan.note.is_empty() {
                         full_runs.push((s.integrator, plan.step_label.clone(), t.frames));
@@ -256,16 +292,33 @@ fn main() {
                         row.vs_full = error(&t.frames, f, p.dimension).0;
                     }
                 }
-                Err(e) => row.note = e.message.replace(',', ";"),
+                Err(e) => {
+                    row.note = e.message.replace(',', ";");
+                    run_by_window.push(Vec::new());
+                }
             }
             rows.push(row);
         }
+        // The longest window from t = 0 over which the reference's own error
+        // stays REFERENCE_MARGIN below the smallest error of any run.
+        let smallest_by_window: Vec<f64> = (0..self_by_window.len())
+            .map(|k| rows[first..].iter().zip(&run_by_window).filter(|(r, _)| r.stable).map(|(_, w)| w[k]).fold(f64::INFINITY, f64::min))
+            .collect();
+        let resolved = (2..=self_by_window.len()).take_while(|&k| REFERENCE_MARGIN * self_by_window[k - 1] <= smallest_by_window[k - 1]).last().unwrap_or(1);
+        let resolved_until_s = (resolved - 1) as f64 * FRAME;
+        for (row, w) in rows[first..].iter_mut().zip(&run_by_window) {
+            row.resolved_until_s = resolved_until_s;
+            row.error_resolved = w.get(resolved - 1).copied().unwrap_or(f64::NAN);
+        }
+        let self_error_resolved = self_by_window[resolved - 1];
         let smallest = rows[first..].iter().filter(|r| r.stable).map(|r| r.error).fold(f64::INFINITY, f64::min);
+        let smallest_resolved = smallest_by_window[resolved - 1];
         let _ = writeln!(
             reference_notes,
-            "| {} | {n} | {reference_dt} | {self_error:.2e} | {smallest:.2e} | {:.0} |",
+            "| {} | {n} | {reference_dt} | {self_error:.2e} | {halved_error:.2e} | {smallest:.2e} | {:.0} | {resolved_until_s:.2} | {self_error_resolved:.2e} | {smallest_resolved:.2e} | {:.0} |",
             case.label,
-            smallest / self_error
+            smallest / self_error,
+            smallest_resolved / self_error_resolved
         );
     }
     bar.finish_with_message("done");
@@ -274,12 +327,28 @@ fn main() {
 }
 
 fn write_csv(out: &str, rows: &[Row]) {
-    let mut csv = String::from("scene,method,integrator,modes,step,internal_steps,setup_s,run_s_per_sim_s,error,max_node_error,stable,vs_full,dofs,step_label,note\n");
+    let mut csv = String::from("scene,method,integrator,modes,step,internal_steps,setup_s,run_s_per_sim_s,error,max_node_error,stable,vs_full,error_resolved,resolved_until_s,dofs,step_label,note\n");
     for r in rows {
         let _ = writeln!(
             csv,
-            "{},{},{},{},{},{},{:.6e},{:.6e},{:.6e},{:.6e},{},{:.6e},{},{},{}",
-            r.scene, r.method, r.integrator, r.modes, r.step, r.internal_steps, r.setup_s, r.run_s_per_sim_s, r.error, r.max_node_error, r.stable, r.vs_full, r.dofs, r.step_label, r.note
+            "{},{},{},{},{},{},{:.6e},{:.6e},{:.6e},{:.6e},{},{:.6e},{:.6e},{},{},{},{}",
+            r.scene,
+            r.method,
+            r.integrator,
+            r.modes,
+            r.step,
+            r.internal_steps,
+            r.setup_s,
+            r.run_s_per_sim_s,
+            r.error,
+            r.max_node_error,
+            r.stable,
+            r.vs_full,
+            r.error_resolved,
+            r.resolved_until_s,
+            r.dofs,
+            r.step_label,
+            r.note
         );
     }
     std::fs::write(format!("{out}/error_vs_runtime.csv"), csv).expect("cannot write the CSV");
@@ -290,7 +359,12 @@ fn pareto<'a>(rows: &[&'a Row]) -> Vec<&'a Row> {
     let mut front: Vec<&Row> = rows
         .iter()
         .copied()
-        .filter(|a| a.stable && !rows.iter().any(|b| b.stable && b.error <= a.error && b.run_s_per_sim_s <= a.run_s_per_sim_s && (b.error < a.error || b.run_s_per_sim_s < a.run_s_per_sim_s)))
+        .filter(|a| {
+            a.stable
+                && !rows.iter().any(|b| {
+                    b.stable && b.error <= a.error && b.run_s_per_sim_s <= a.run_s_per_sim_s && (b.error < a.error || b.run_s_per_sim_s < a.run_s_per_sim_s)
+                })
+        })
         .collect();
     front.sort_by(|a, b| a.run_s_per_sim_s.total_cmp(&b.run_s_per_sim_s));
     front
@@ -329,8 +403,14 @@ fn write_readme(out: &str, rows: &[Row], reference_notes: &str, quick: bool, sec
     );
     let _ = writeln!(
         md,
-        "## References\n\nEach reference is checked against a run at half its step; the smallest error reported must stay well above that.\n\n\
-         | scene | free DOFs | reference dt (s) | E(dt) against E(dt/2) | smallest E reported | ratio |\n|---|---|---|---|---|---|\n{reference_notes}"
+        "## References\n\nEach reference is checked against runs at half and a quarter of its step; the smallest error reported must \
+         stay at least {REFERENCE_MARGIN}x above its own. Where E(dt) against E(dt/2) does not shrink with the step (column 5 not \
+         about a quarter of column 4), the trajectory itself is sensitive: a round-off-sized difference grows until it is as large \
+         as the errors reported. The window \"resolved until\" is the longest from t = 0 over which the reference's own error \
+         stays {REFERENCE_MARGIN}x below the smallest error of any run over the same window; `error_resolved` in the CSV is E \
+         over that window.\n\n\
+         | scene | free DOFs | reference dt (s) | E(dt) against E(dt/2) | E(dt/2) against E(dt/4) | smallest E reported | ratio | \
+         resolved until (s) | E(dt) against E(dt/2) there | smallest E there | ratio there |\n|---|---|---|---|---|---|---|---|---|---|---|\n{reference_notes}"
     );
     let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
     scenes.dedup();
@@ -342,18 +422,33 @@ fn write_readme(out: &str, rows: &[Row], reference_notes: &str, quick: bool, sec
          full-space run matches on error needs a smaller step or more modes than the study has. Modal runs with E of \
          {USEFUL_ERROR} or more miss most of the motion (E = 1 is a sheet that does not move) and are left out.\n"
     );
-    let _ = writeln!(md, "| scene | modal run | E | run s / sim s | fastest full-space run at that error | its run s / sim s | speed-up |\n|---|---|---|---|---|---|---|");
+    let _ = writeln!(
+        md,
+        "| scene | modal run | E | run s / sim s | fastest full-space run at that error | its run s / sim s | speed-up |\n|---|---|---|---|---|---|---|"
+    );
     for &scene in &scenes {
         let rs: Vec<&Row> = rows.iter().filter(|r| r.scene == scene).collect();
         let front: Vec<&Row> = pareto(&rs).into_iter().filter(|r| r.method == "modal" && r.error < USEFUL_ERROR).collect();
         if front.is_empty() {
             let best = rs.iter().filter(|r| r.method == "modal" && r.stable).min_by(|a, b| a.error.total_cmp(&b.error));
-            let _ = writeln!(md, "| {scene} | no modal run with E below {USEFUL_ERROR} on the Pareto front{} | | | | | |", best.map(|b| format!(" (best modal: {}, E = {:.2e})", describe(b), b.error)).unwrap_or_default());
+            let _ = writeln!(
+                md,
+                "| {scene} | no modal run with E below {USEFUL_ERROR} on the Pareto front{} | | | | | |",
+                best.map(|b| format!(" (best modal: {}, E = {:.2e})", describe(b), b.error)).unwrap_or_default()
+            );
         }
         for m in front {
             match speedup(m, &rs) {
                 Some((f, ratio)) => {
-                    let _ = writeln!(md, "| {scene} | {} | {:.2e} | {:.2e} | {} | {:.2e} | {ratio:.2} |", describe(m), m.error, m.run_s_per_sim_s, describe(f), f.run_s_per_sim_s);
+                    let _ = writeln!(
+                        md,
+                        "| {scene} | {} | {:.2e} | {:.2e} | {} | {:.2e} | {ratio:.2} |",
+                        describe(m),
+                        m.error,
+                        m.run_s_per_sim_s,
+                        describe(f),
+                        f.run_s_per_sim_s
+                    );
                 }
                 None => {
                     let _ = writeln!(md, "| {scene} | {} | {:.2e} | {:.2e} | none as accurate | | |", describe(m), m.error, m.run_s_per_sim_s);
@@ -364,13 +459,23 @@ fn write_readme(out: &str, rows: &[Row], reference_notes: &str, quick: bool, sec
     let _ = writeln!(md, "\n## Set-up against mesh size\n\nAssembly plus eigen decomposition (modal) or sparse symbolic analysis (full), from the explicit runs at step 1/240 s.\n");
     let _ = writeln!(md, "| scene | free DOFs | full (s) | modal r = 8 (s) | modal, most modes run (s) |\n|---|---|---|---|---|");
     for &scene in &scenes {
-        let pick = |f: &dyn Fn(&Row) -> bool| rows.iter().filter(|r| r.scene == scene && r.step_label == "1/240" && r.integrator == "newmark-explicit" && r.setup_s.is_finite() && f(r)).max_by_key(|r| r.modes);
+        let pick = |f: &dyn Fn(&Row) -> bool| {
+            rows.iter()
+                .filter(|r| r.scene == scene && r.step_label == "1/240" && r.integrator == "newmark-explicit" && r.setup_s.is_finite() && f(r))
+                .max_by_key(|r| r.modes)
+        };
         let dofs = rows.iter().find(|r| r.scene == scene).map(|r| r.dofs).unwrap_or(0);
         let full = pick(&|r| r.method == "full" && r.note.is_empty());
         let r8 = pick(&|r| r.method == "modal" && r.modes == 8);
         let most = pick(&|r| r.method == "modal");
         let fmt = |r: Option<&Row>| r.map(|r| format!("{:.3e}", r.setup_s)).unwrap_or_else(|| "-".into());
-        let _ = writeln!(md, "| {scene} | {dofs} | {} | {} | {} |", fmt(full), fmt(r8), most.map(|r| format!("{:.3e} (r = {})", r.setup_s, r.modes)).unwrap_or_else(|| "-".into()));
+        let _ = writeln!(
+            md,
+            "| {scene} | {dofs} | {} | {} | {} |",
+            fmt(full),
+            fmt(r8),
+            most.map(|r| format!("{:.3e} (r = {})", r.setup_s, r.modes)).unwrap_or_else(|| "-".into())
+        );
     }
     let _ = writeln!(md);
     for &scene in &scenes {

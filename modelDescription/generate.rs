@@ -262,9 +262,7 @@ impl Spec {
 
     /// Start-value overrides of a canonical scene.
     pub fn scene(&self, name: &str) -> Option<BTreeMap<String, Vec<f64>>> {
-        self.scenes
-            .get(name)
-            .map(|t| t.iter().map(|(k, v)| (k.clone(), numbers(v))).collect())
+        self.scenes.get(name).map(|t| t.iter().map(|(k, v)| (k.clone(), numbers(v))).collect())
     }
 
     pub fn scene_names(&self) -> Vec<String> {
@@ -299,23 +297,12 @@ impl Spec {
         }
         w.push_str("  </UnitDefinitions>\n  <TypeDefinitions>\n");
         for u in &self.units {
-            let _ = writeln!(
-                w,
-                "    <Float64Type name=\"{q}\" quantity=\"{q}\" unit=\"{}\"/>",
-                esc(&u.name),
-                q = esc(&u.quantity)
-            );
+            let _ = writeln!(w, "    <Float64Type name=\"{q}\" quantity=\"{q}\" unit=\"{}\"/>", esc(&u.name), q = esc(&u.quantity));
         }
         for e in &self.enumerations {
             let _ = writeln!(w, "    <EnumerationType name=\"{}\" description=\"{}\">", esc(&e.name), esc(&e.description));
             for i in &e.items {
-                let _ = writeln!(
-                    w,
-                    "      <Item name=\"{}\" value=\"{}\" description=\"{}\"/>",
-                    esc(&i.name),
-                    i.value,
-                    esc(&i.description)
-                );
+                let _ = writeln!(w, "      <Item name=\"{}\" value=\"{}\" description=\"{}\"/>", esc(&i.name), i.value, esc(&i.description));
             }
             w.push_str("    </EnumerationType>\n");
         }
@@ -381,11 +368,7 @@ impl Spec {
         for v in &outputs {
             let _ = writeln!(w, "    <Output valueReference=\"{}\"/>", v.vr);
         }
-        let mut initial: Vec<&Variable> = self
-            .variables
-            .iter()
-            .filter(|v| v.causality == "output" || v.causality == "calculatedParameter")
-            .collect();
+        let mut initial: Vec<&Variable> = self.variables.iter().filter(|v| v.causality == "output" || v.causality == "calculatedParameter").collect();
         initial.sort_by_key(|v| v.vr);
         for v in &initial {
             let _ = writeln!(w, "    <InitialUnknown valueReference=\"{}\"/>", v.vr);
@@ -436,10 +419,7 @@ impl Spec {
                     Dim::Param(p) => p.clone(),
                 })
                 .collect();
-            let start = starts
-                .get(&v.name)
-                .map(|s| s.iter().map(|x| number(&v.ty, *x)).collect::<Vec<_>>().join(" "))
-                .unwrap_or_default();
+            let start = starts.get(&v.name).map(|s| s.iter().map(|x| number(&v.ty, *x)).collect::<Vec<_>>().join(" ")).unwrap_or_default();
             let _ = writeln!(
                 h,
                 "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",

@@ -4,5 +4,5 @@
 //! [`physics`] is the solver and knows nothing of FMI; [`fmi`] is the thin
 //! layer of `fmi3*` exports over it.
 
-pub mod physics;
 pub mod fmi;
+pub mod physics;

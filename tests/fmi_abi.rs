@@ -46,10 +46,7 @@ fn instantiation_checks_token_name_and_interface() {
     for (what, n, t, e, r) in refused {
         assert!(cs(n, t, e, r, Some(logger)).is_null(), "{what}");
         let logged = log.take();
-        assert!(
-            matches!(logged.as_slice(), [(ERROR, c, m)] if c == "logStatusError" && m.starts_with("fmi3InstantiateCoSimulation: ")),
-            "{what}: {logged:?}"
-        );
+        assert!(matches!(logged.as_slice(), [(ERROR, c, m)] if c == "logStatusError" && m.starts_with("fmi3InstantiateCoSimulation: ")), "{what}: {logged:?}");
         // Refused without a logger too, and without touching it.
         assert!(cs(n, t, e, r, None).is_null(), "{what} without logger");
     }
@@ -60,9 +57,7 @@ fn instantiation_checks_token_name_and_interface() {
 
     log.0.lock().unwrap().clear();
     let me = unsafe { fmi3InstantiateModelExchange(null(), good.as_ptr(), null(), false, false, env, Some(logger)) };
-    let se = unsafe {
-        fmi3InstantiateScheduledExecution(null(), good.as_ptr(), null(), false, false, env, Some(logger), None, None, None)
-    };
+    let se = unsafe { fmi3InstantiateScheduledExecution(null(), good.as_ptr(), null(), false, false, env, Some(logger), None, None, None) };
     assert!(me.is_null() && se.is_null());
     assert_eq!(log.0.lock().unwrap().len(), 2);
 }
@@ -397,10 +392,7 @@ fn a_step_that_cannot_be_done_is_discarded_and_the_state_kept() {
     f.log.take();
     assert_eq!(f.step(0.0, 1.0), DISCARD);
     let logged = f.log.take();
-    assert!(
-        matches!(logged.as_slice(), [(DISCARD, c, m)] if c == "logStatusDiscard" && m.contains("internal steps")),
-        "{logged:?}"
-    );
+    assert!(matches!(logged.as_slice(), [(DISCARD, c, m)] if c == "logStatusDiscard" && m.contains("internal steps")), "{logged:?}");
     assert_eq!(f.snapshot(), before, "the discarded step left the state as it was");
     // A shorter step goes through.
     assert_eq!(f.step(0.0, 1e-6), OK);
@@ -600,8 +592,17 @@ fn every_corruption_of_a_serialized_state_is_refused() {
         ("truncated", blob[..blob.len() - 1].to_vec()),
         ("header only", blob[..HEADER].to_vec()),
         ("one byte more", [blob.clone(), vec![0]].concat()),
-        ("flipped byte in the payload", { let mut b = blob.clone(); b[HEADER + 3] ^= 0x40; b }),
-        ("flipped checksum", { let mut b = blob.clone(); let n = b.len(); b[n - 1] ^= 1; b }),
+        ("flipped byte in the payload", {
+            let mut b = blob.clone();
+            b[HEADER + 3] ^= 0x40;
+            b
+        }),
+        ("flipped checksum", {
+            let mut b = blob.clone();
+            let n = b.len();
+            b[n - 1] ^= 1;
+            b
+        }),
         ("zeros", vec![0; blob.len()]),
     ] {
         refused_unchanged(&f, &bad, what);

@@ -35,8 +35,7 @@ fn parses_with_fmi_schema_and_matches_the_binary() {
         assert_eq!(md.instantiation_token, variables::INSTANTIATION_TOKEN);
         assert!(md.co_simulation.is_some(), "{name}: no CoSimulation element");
         assert!(md.model_exchange.is_none() && md.scheduled_execution.is_none());
-        let parsed: BTreeMap<u32, String> =
-            md.model_variables.iter_abstract().map(|v| (v.value_reference(), v.name().to_string())).collect();
+        let parsed: BTreeMap<u32, String> = md.model_variables.iter_abstract().map(|v| (v.value_reference(), v.name().to_string())).collect();
         for v in VARIABLES.iter().filter(|v| v.ty != Type::Int64) {
             assert_eq!(parsed.get(&v.vr), Some(&v.name.to_string()), "{name}: {} (vr {})", v.name, v.vr);
         }
@@ -59,8 +58,7 @@ fn every_variable_of_the_xml_is_in_the_binary_table() {
 #[test]
 fn validates_with_fmi_rs() {
     for (name, xml) in descriptions() {
-        let md = fmi_rs::model_description::fmi3::ModelDescription::from_string(&xml)
-            .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+        let md = fmi_rs::model_description::fmi3::ModelDescription::from_string(&xml).unwrap_or_else(|e| panic!("{name}: {e:?}"));
         let problems: Vec<String> = md.validate().into_iter().map(|p| p.message).collect();
         assert!(problems.is_empty(), "{name}: {problems:#?}");
     }
@@ -134,21 +132,81 @@ fn defaults_are_paper_2d_top_row() {
 fn c_header_declares_every_export() {
     let h = modal_mass_spring::fmi::C_HEADER;
     let names = [
-        "GetVersion", "SetDebugLogging", "InstantiateModelExchange", "InstantiateCoSimulation",
-        "InstantiateScheduledExecution", "FreeInstance", "EnterInitializationMode", "ExitInitializationMode",
-        "EnterEventMode", "Terminate", "Reset", "GetFloat32", "GetFloat64", "GetInt8", "GetUInt8", "GetInt16",
-        "GetUInt16", "GetInt32", "GetUInt32", "GetInt64", "GetUInt64", "GetBoolean", "GetString", "GetBinary",
-        "GetClock", "SetFloat32", "SetFloat64", "SetInt8", "SetUInt8", "SetInt16", "SetUInt16", "SetInt32",
-        "SetUInt32", "SetInt64", "SetUInt64", "SetBoolean", "SetString", "SetBinary", "SetClock",
-        "GetNumberOfVariableDependencies", "GetVariableDependencies", "GetFMUState", "SetFMUState",
-        "FreeFMUState", "SerializedFMUStateSize", "SerializeFMUState", "DeserializeFMUState",
-        "GetDirectionalDerivative", "GetAdjointDerivative", "EnterConfigurationMode", "ExitConfigurationMode",
-        "GetIntervalDecimal", "GetIntervalFraction", "GetShiftDecimal", "GetShiftFraction", "SetIntervalDecimal",
-        "SetIntervalFraction", "SetShiftDecimal", "SetShiftFraction", "EvaluateDiscreteStates",
-        "UpdateDiscreteStates", "EnterContinuousTimeMode", "CompletedIntegratorStep", "SetTime",
-        "SetContinuousStates", "GetContinuousStateDerivatives", "GetEventIndicators", "GetContinuousStates",
-        "GetNominalsOfContinuousStates", "GetNumberOfEventIndicators", "GetNumberOfContinuousStates",
-        "EnterStepMode", "GetOutputDerivatives", "DoStep", "ActivateModelPartition",
+        "GetVersion",
+        "SetDebugLogging",
+        "InstantiateModelExchange",
+        "InstantiateCoSimulation",
+        "InstantiateScheduledExecution",
+        "FreeInstance",
+        "EnterInitializationMode",
+        "ExitInitializationMode",
+        "EnterEventMode",
+        "Terminate",
+        "Reset",
+        "GetFloat32",
+        "GetFloat64",
+        "GetInt8",
+        "GetUInt8",
+        "GetInt16",
+        "GetUInt16",
+        "GetInt32",
+        "GetUInt32",
+        "GetInt64",
+        "GetUInt64",
+        "GetBoolean",
+        "GetString",
+        "GetBinary",
+        "GetClock",
+        "SetFloat32",
+        "SetFloat64",
+        "SetInt8",
+        "SetUInt8",
+        "SetInt16",
+        "SetUInt16",
+        "SetInt32",
+        "SetUInt32",
+        "SetInt64",
+        "SetUInt64",
+        "SetBoolean",
+        "SetString",
+        "SetBinary",
+        "SetClock",
+        "GetNumberOfVariableDependencies",
+        "GetVariableDependencies",
+        "GetFMUState",
+        "SetFMUState",
+        "FreeFMUState",
+        "SerializedFMUStateSize",
+        "SerializeFMUState",
+        "DeserializeFMUState",
+        "GetDirectionalDerivative",
+        "GetAdjointDerivative",
+        "EnterConfigurationMode",
+        "ExitConfigurationMode",
+        "GetIntervalDecimal",
+        "GetIntervalFraction",
+        "GetShiftDecimal",
+        "GetShiftFraction",
+        "SetIntervalDecimal",
+        "SetIntervalFraction",
+        "SetShiftDecimal",
+        "SetShiftFraction",
+        "EvaluateDiscreteStates",
+        "UpdateDiscreteStates",
+        "EnterContinuousTimeMode",
+        "CompletedIntegratorStep",
+        "SetTime",
+        "SetContinuousStates",
+        "GetContinuousStateDerivatives",
+        "GetEventIndicators",
+        "GetContinuousStates",
+        "GetNominalsOfContinuousStates",
+        "GetNumberOfEventIndicators",
+        "GetNumberOfContinuousStates",
+        "EnterStepMode",
+        "GetOutputDerivatives",
+        "DoStep",
+        "ActivateModelPartition",
     ];
     assert_eq!(names.len(), 75);
     for n in names {

@@ -113,9 +113,7 @@ fn rows() -> Vec<Row> {
     use Mode::*;
     let mut r = vec![
         row("fmi3SetDebugLogging", EVERY, None, |f| unsafe { fmi3SetDebugLogging(f.inst, true, 0, null()) }),
-        row("fmi3EnterInitializationMode", "IR", Some(InitializationMode), |f| unsafe {
-            fmi3EnterInitializationMode(f.inst, false, 0.0, 0.0, true, 10.0)
-        }),
+        row("fmi3EnterInitializationMode", "IR", Some(InitializationMode), |f| unsafe { fmi3EnterInitializationMode(f.inst, false, 0.0, 0.0, true, 10.0) }),
         row("fmi3ExitInitializationMode", "N", Some(StepMode), |f| unsafe { fmi3ExitInitializationMode(f.inst) }),
         // No tunable structural parameters, so no Reconfiguration Mode from Step Mode.
         row("fmi3EnterConfigurationMode", "IR", Some(ConfigurationMode), |f| unsafe { fmi3EnterConfigurationMode(f.inst) }),
@@ -200,14 +198,10 @@ fn rows() -> Vec<Row> {
         }),
         row("fmi3SetTime", NONE, None, |f| unsafe { fmi3SetTime(f.inst, 0.0) }),
         row("fmi3SetContinuousStates", NONE, None, |f| unsafe { fmi3SetContinuousStates(f.inst, [0.0].as_ptr(), 1) }),
-        row("fmi3GetContinuousStateDerivatives", NONE, None, |f| unsafe {
-            fmi3GetContinuousStateDerivatives(f.inst, [0.0].as_mut_ptr(), 1)
-        }),
+        row("fmi3GetContinuousStateDerivatives", NONE, None, |f| unsafe { fmi3GetContinuousStateDerivatives(f.inst, [0.0].as_mut_ptr(), 1) }),
         row("fmi3GetEventIndicators", NONE, None, |f| unsafe { fmi3GetEventIndicators(f.inst, [0.0].as_mut_ptr(), 1) }),
         row("fmi3GetContinuousStates", NONE, None, |f| unsafe { fmi3GetContinuousStates(f.inst, [0.0].as_mut_ptr(), 1) }),
-        row("fmi3GetNominalsOfContinuousStates", NONE, None, |f| unsafe {
-            fmi3GetNominalsOfContinuousStates(f.inst, [0.0].as_mut_ptr(), 1)
-        }),
+        row("fmi3GetNominalsOfContinuousStates", NONE, None, |f| unsafe { fmi3GetNominalsOfContinuousStates(f.inst, [0.0].as_mut_ptr(), 1) }),
         row("fmi3GetNumberOfEventIndicators", NONE, None, |f| unsafe { fmi3GetNumberOfEventIndicators(f.inst, &mut 0) }),
         row("fmi3GetNumberOfContinuousStates", NONE, None, |f| unsafe { fmi3GetNumberOfContinuousStates(f.inst, &mut 0) }),
         row("fmi3GetDirectionalDerivative", NONE, None, |f| unsafe {
@@ -216,12 +210,8 @@ fn rows() -> Vec<Row> {
         row("fmi3GetAdjointDerivative", NONE, None, |f| unsafe {
             fmi3GetAdjointDerivative(f.inst, &vr::KINETIC_ENERGY, 1, &vr::GRAVITY, 1, &1.0, 1, &mut 0.0, 1)
         }),
-        row("fmi3GetOutputDerivatives", NONE, None, |f| unsafe {
-            fmi3GetOutputDerivatives(f.inst, &vr::KINETIC_ENERGY, 1, &1, &mut 0.0, 1)
-        }),
-        row("fmi3GetNumberOfVariableDependencies", NONE, None, |f| unsafe {
-            fmi3GetNumberOfVariableDependencies(f.inst, vr::POSITIONS, &mut 0)
-        }),
+        row("fmi3GetOutputDerivatives", NONE, None, |f| unsafe { fmi3GetOutputDerivatives(f.inst, &vr::KINETIC_ENERGY, 1, &1, &mut 0.0, 1) }),
+        row("fmi3GetNumberOfVariableDependencies", NONE, None, |f| unsafe { fmi3GetNumberOfVariableDependencies(f.inst, vr::POSITIONS, &mut 0) }),
         row("fmi3GetVariableDependencies", NONE, None, |f| unsafe {
             fmi3GetVariableDependencies(f.inst, vr::POSITIONS, null_mut(), null_mut(), null_mut(), null_mut(), 0)
         }),

@@ -113,7 +113,15 @@ const DRIFT: &str = "energy drift, undamped, internal steps of 1e-3 s: 1e5 of th
 fn extremes() -> Vec<Extreme> {
     use Value::*;
     vec![
-        Extreme { label: "defaults (k 50 N/m, m 0.01 kg, g 9.81), 1 s at 0.01 s", applies: all, set: none, t_end: one_second, steps: &[0.01], gravity: None, compare: false },
+        Extreme {
+            label: "defaults (k 50 N/m, m 0.01 kg, g 9.81), 1 s at 0.01 s",
+            applies: all,
+            set: none,
+            t_end: one_second,
+            steps: &[0.01],
+            gravity: None,
+            compare: false,
+        },
         Extreme {
             label: "springStiffness 1e-3 N/m (1e5 below default), 1 s",
             applies: all,
@@ -132,8 +140,24 @@ fn extremes() -> Vec<Extreme> {
             gravity: None,
             compare: false,
         },
-        Extreme { label: "nodeMass 1e-6 kg, 0.02 s", applies: all, set: |_| vec![(vr::NODE_MASS, F(vec![1e-6]))], t_end: fiftieth, steps: &[0.01], gravity: None, compare: false },
-        Extreme { label: "nodeMass 1e3 kg, 1 s", applies: all, set: |_| vec![(vr::NODE_MASS, F(vec![1e3]))], t_end: one_second, steps: &[0.01], gravity: None, compare: false },
+        Extreme {
+            label: "nodeMass 1e-6 kg, 0.02 s",
+            applies: all,
+            set: |_| vec![(vr::NODE_MASS, F(vec![1e-6]))],
+            t_end: fiftieth,
+            steps: &[0.01],
+            gravity: None,
+            compare: false,
+        },
+        Extreme {
+            label: "nodeMass 1e3 kg, 1 s",
+            applies: all,
+            set: |_| vec![(vr::NODE_MASS, F(vec![1e3]))],
+            t_end: one_second,
+            steps: &[0.01],
+            gravity: None,
+            compare: false,
+        },
         Extreme {
             label: "k/m = 1e15 /s² (k 1e9, m 1e-6), 0.01 s",
             applies: all,
@@ -239,10 +263,42 @@ fn extremes() -> Vec<Extreme> {
             gravity: None,
             compare: false,
         },
-        Extreme { label: "spacing 0 (coincident nodes)", applies: all, set: |_| vec![(vr::SPACING, F(vec![0.0]))], t_end: one_second, steps: &[0.01], gravity: None, compare: false },
-        Extreme { label: "spacing −0.1", applies: all, set: |_| vec![(vr::SPACING, F(vec![-0.1]))], t_end: one_second, steps: &[0.01], gravity: None, compare: false },
-        Extreme { label: "nx 1 (a hanging chain), 1 s", applies: all, set: |_| vec![(vr::NX, U(1))], t_end: one_second, steps: &[0.01], gravity: None, compare: false },
-        Extreme { label: "ny 1 (the fixed row alone)", applies: all, set: |_| vec![(vr::NY, U(1))], t_end: one_second, steps: &[0.01], gravity: None, compare: false },
+        Extreme {
+            label: "spacing 0 (coincident nodes)",
+            applies: all,
+            set: |_| vec![(vr::SPACING, F(vec![0.0]))],
+            t_end: one_second,
+            steps: &[0.01],
+            gravity: None,
+            compare: false,
+        },
+        Extreme {
+            label: "spacing −0.1",
+            applies: all,
+            set: |_| vec![(vr::SPACING, F(vec![-0.1]))],
+            t_end: one_second,
+            steps: &[0.01],
+            gravity: None,
+            compare: false,
+        },
+        Extreme {
+            label: "nx 1 (a hanging chain), 1 s",
+            applies: all,
+            set: |_| vec![(vr::NX, U(1))],
+            t_end: one_second,
+            steps: &[0.01],
+            gravity: None,
+            compare: false,
+        },
+        Extreme {
+            label: "ny 1 (the fixed row alone)",
+            applies: all,
+            set: |_| vec![(vr::NY, U(1))],
+            t_end: one_second,
+            steps: &[0.01],
+            gravity: None,
+            compare: false,
+        },
         Extreme { label: "nModes 0", applies: all, set: |_| vec![(vr::N_MODES, U(0))], t_end: one_second, steps: &[0.01], gravity: None, compare: false },
         Extreme {
             label: "nModes one more than the free DOFs",
@@ -261,8 +317,21 @@ fn extremes() -> Vec<Extreme> {
 
 /// The variable names a refusal may name.
 const PARAMETERS: &[&str] = &[
-    "nx", "ny", "dimension", "nModes", "spacing", "nodeMass", "springStiffness", "shearSprings", "bendingSprings", "auxStiffness",
-    "maxInternalStep", "fixedNodes", "reduction", "integrator", "gravity",
+    "nx",
+    "ny",
+    "dimension",
+    "nModes",
+    "spacing",
+    "nodeMass",
+    "springStiffness",
+    "shearSprings",
+    "bendingSprings",
+    "auxStiffness",
+    "maxInternalStep",
+    "fixedNodes",
+    "reduction",
+    "integrator",
+    "gravity",
 ];
 
 #[derive(Clone, Debug, PartialEq)]
@@ -390,12 +459,7 @@ fn run_cell(e: &Extreme, s: &SceneDef, modal: bool, implicit: bool) -> Cell {
         let q = f.f64s(vr::MODAL_COORDINATES, r);
         let k = f.f64s(vr::KINETIC_ENERGY, 1)[0];
         let en = energy(&f);
-        assert!(
-            p.iter().chain(&v).chain(&q).all(|x| x.is_finite()) && en.is_finite(),
-            "{} {} at t = {t}: a non-finite output after fmi3OK",
-            s.name,
-            e.label
-        );
+        assert!(p.iter().chain(&v).chain(&q).all(|x| x.is_finite()) && en.is_finite(), "{} {} at t = {t}: a non-finite output after fmi3OK", s.name, e.label);
         k_max = k_max.max(k);
         let scale = k_max.max(ENERGY_FLOOR * work);
         if scale > 0.0 {
@@ -435,8 +499,7 @@ const COLUMNS: [(bool, bool, &str); 4] =
 #[test]
 fn stability_matrix() {
     let extremes = extremes();
-    let jobs: Vec<(usize, usize, usize)> =
-        (0..extremes.len()).flat_map(|e| (0..SCENES.len()).flat_map(move |s| (0..4).map(move |c| (e, s, c)))).collect();
+    let jobs: Vec<(usize, usize, usize)> = (0..extremes.len()).flat_map(|e| (0..SCENES.len()).flat_map(move |s| (0..4).map(move |c| (e, s, c)))).collect();
     let next = Mutex::new(0usize);
     let results: Mutex<Vec<Option<Cell>>> = Mutex::new((0..jobs.len()).map(|_| None).collect());
     let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
@@ -539,9 +602,5 @@ fn check_readme(root: &std::path::Path, table: &str) {
         return;
     }
     let section = section.expect("README has no stability table (run cargo xtask stability)");
-    assert_eq!(
-        outcomes(section),
-        outcomes(table),
-        "the README's stability table disagrees with this run (target/stability.md); run `cargo xtask stability`"
-    );
+    assert_eq!(outcomes(section), outcomes(table), "the README's stability table disagrees with this run (target/stability.md); run `cargo xtask stability`");
 }

@@ -36,8 +36,27 @@ impl Input<'_> {
 }
 
 const F64: &[f64] = &[
-    0.0, -0.0, 1.0, -1.0, 0.5, 2.0, 0.01, 0.05, 0.1, 50.0, 1e3, 1e-3, -9.81, 1e-300, 1e300, f64::MIN_POSITIVE, 5e-324,
-    f64::MAX, f64::NAN, f64::INFINITY, f64::NEG_INFINITY,
+    0.0,
+    -0.0,
+    1.0,
+    -1.0,
+    0.5,
+    2.0,
+    0.01,
+    0.05,
+    0.1,
+    50.0,
+    1e3,
+    1e-3,
+    -9.81,
+    1e-300,
+    1e300,
+    f64::MIN_POSITIVE,
+    5e-324,
+    f64::MAX,
+    f64::NAN,
+    f64::INFINITY,
+    f64::NEG_INFINITY,
 ];
 const GRID: &[u64] = &[0, 1, 2, 3, 4, 6, 10, 1001, 1 << 53, u64::MAX];
 const DIMENSION: &[u64] = &[0, 1, 2, 3, 4];
@@ -105,9 +124,7 @@ fn op(w: &mut World, input: &mut Input) -> Option<()> {
         let names = [CString::new("fuzz").unwrap(), CString::new("").unwrap(), CString::new(" ").unwrap()];
         let name = if name_ok == 3 { null() } else { names[name_ok as usize].as_ptr() };
         let token = [good.as_ptr(), wrong.as_ptr(), null()][token_ok as usize];
-        let inst = unsafe {
-            f.fmi3InstantiateCoSimulation(name, token, null(), false, input.flag()?, false, false, null(), 0, env.ptr(), Some(logger), None)
-        };
+        let inst = unsafe { f.fmi3InstantiateCoSimulation(name, token, null(), false, input.flag()?, false, false, null(), 0, env.ptr(), Some(logger), None) };
         if name_ok == 0 && token_ok == 0 {
             assert!(!inst.is_null(), "valid instantiation refused");
             w.slots[which] = Some(Slot { env, inst, states: Vec::new() });

@@ -96,9 +96,7 @@ fuzz_target!(|data: &[u8]| {
     };
 
     let mut st: fmi3FMUState = null_mut();
-    let s = checked(inst, env, "fmi3DeserializeFMUState", false, &mut || unsafe {
-        f.fmi3DeserializeFMUState(inst, blob.as_ptr(), blob.len(), &mut st)
-    });
+    let s = checked(inst, env, "fmi3DeserializeFMUState", false, &mut || unsafe { f.fmi3DeserializeFMUState(inst, blob.as_ptr(), blob.len(), &mut st) });
     if s == OK {
         assert!(!st.is_null());
         // Serializing what was accepted gives a blob that reads back to itself.
@@ -112,9 +110,7 @@ fuzz_target!(|data: &[u8]| {
             let _ = outputs(inst);
             let t = time(inst);
             let (mut a, mut b, mut c, mut last) = (false, false, false, 0.0);
-            let step = checked(inst, env, "fmi3DoStep", true, &mut || unsafe {
-                f.fmi3DoStep(inst, t, 1e-4, false, &mut a, &mut b, &mut c, &mut last)
-            });
+            let step = checked(inst, env, "fmi3DoStep", true, &mut || unsafe { f.fmi3DoStep(inst, t, 1e-4, false, &mut a, &mut b, &mut c, &mut last) });
             if step == OK {
                 assert!(outputs(inst).is_some(), "outputs refused after a successful step");
             }

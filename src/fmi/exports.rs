@@ -452,7 +452,9 @@ pub unsafe extern "C" fn fmi3SetInt64(
     values: *const fmi3Int64,
     nValues: usize,
 ) -> fmi3Status {
-    call(instance, "fmi3SetInt64", |inst| inst.set("fmi3SetInt64", Type::Int64, valueReferences, nValueReferences, values, nValues, |x: i64| (x.unsigned_abs() <= 1 << 53).then_some(x as f64)))
+    call(instance, "fmi3SetInt64", |inst| {
+        inst.set("fmi3SetInt64", Type::Int64, valueReferences, nValueReferences, values, nValues, |x: i64| (x.unsigned_abs() <= 1 << 53).then_some(x as f64))
+    })
 }
 const _: fmi3SetInt64TYPE = Some(fmi3SetInt64);
 
@@ -476,7 +478,9 @@ pub unsafe extern "C" fn fmi3SetUInt64(
     values: *const fmi3UInt64,
     nValues: usize,
 ) -> fmi3Status {
-    call(instance, "fmi3SetUInt64", |inst| inst.set("fmi3SetUInt64", Type::UInt64, valueReferences, nValueReferences, values, nValues, |x: u64| (x <= 1 << 53).then_some(x as f64)))
+    call(instance, "fmi3SetUInt64", |inst| {
+        inst.set("fmi3SetUInt64", Type::UInt64, valueReferences, nValueReferences, values, nValues, |x: u64| (x <= 1 << 53).then_some(x as f64))
+    })
 }
 const _: fmi3SetUInt64TYPE = Some(fmi3SetUInt64);
 
@@ -502,7 +506,9 @@ pub unsafe extern "C" fn fmi3SetBoolean(
 ) -> fmi3Status {
     // Read as bytes: a host may pass any non-zero value for true.
     let bytes = values as *const u8;
-    call(instance, "fmi3SetBoolean", |inst| inst.set("fmi3SetBoolean", Type::Boolean, valueReferences, nValueReferences, bytes, nValues, |x: u8| Some(if x != 0 { 1.0 } else { 0.0 })))
+    call(instance, "fmi3SetBoolean", |inst| {
+        inst.set("fmi3SetBoolean", Type::Boolean, valueReferences, nValueReferences, bytes, nValues, |x: u8| Some(if x != 0 { 1.0 } else { 0.0 }))
+    })
 }
 const _: fmi3SetBooleanTYPE = Some(fmi3SetBoolean);
 
@@ -561,14 +567,24 @@ pub unsafe extern "C" fn fmi3SetBinary(
 const _: fmi3SetBinaryTYPE = Some(fmi3SetBinary);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetClock(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, values: *mut fmi3Clock) -> fmi3Status {
+pub unsafe extern "C" fn fmi3GetClock(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    values: *mut fmi3Clock,
+) -> fmi3Status {
     let _ = values;
     call(instance, "fmi3GetClock", |inst| no_variables(inst, "fmi3GetClock", "Clock", valueReferences, nValueReferences, mask::GET))
 }
 const _: fmi3GetClockTYPE = Some(fmi3GetClock);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetClock(instance: fmi3Instance, valueReferences: *const fmi3ValueReference, nValueReferences: usize, values: *const fmi3Clock) -> fmi3Status {
+pub unsafe extern "C" fn fmi3SetClock(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    values: *const fmi3Clock,
+) -> fmi3Status {
     let _ = values;
     call(instance, "fmi3SetClock", |inst| no_variables(inst, "fmi3SetClock", "Clock", valueReferences, nValueReferences, mask::SET))
 }
@@ -577,7 +593,11 @@ const _: fmi3SetClockTYPE = Some(fmi3SetClock);
 // ---- Variable dependencies ----------------------------------------------------
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetNumberOfVariableDependencies(instance: fmi3Instance, _valueReference: fmi3ValueReference, _nDependencies: *mut usize) -> fmi3Status {
+pub unsafe extern "C" fn fmi3GetNumberOfVariableDependencies(
+    instance: fmi3Instance,
+    _valueReference: fmi3ValueReference,
+    _nDependencies: *mut usize,
+) -> fmi3Status {
     unsupported(instance, "fmi3GetNumberOfVariableDependencies", "variable dependencies are not provided (every output depends on every parameter)")
 }
 const _: fmi3GetNumberOfVariableDependenciesTYPE = Some(fmi3GetNumberOfVariableDependencies);
@@ -646,10 +666,7 @@ pub unsafe extern "C" fn fmi3SerializeFMUState(instance: fmi3Instance, FMUState:
             return Err(inst.fail("fmi3SerializeFMUState: serializedState is NULL"));
         }
         if size != bytes.len() {
-            return Err(inst.fail(&format!(
-                "fmi3SerializeFMUState: size is {size}, fmi3SerializedFMUStateSize gave {}",
-                bytes.len()
-            )));
+            return Err(inst.fail(&format!("fmi3SerializeFMUState: size is {size}, fmi3SerializedFMUStateSize gave {}", bytes.len())));
         }
         unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), serializedState, size) };
         Ok(OK)
@@ -658,7 +675,12 @@ pub unsafe extern "C" fn fmi3SerializeFMUState(instance: fmi3Instance, FMUState:
 const _: fmi3SerializeFMUStateTYPE = Some(fmi3SerializeFMUState);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3DeserializeFMUState(instance: fmi3Instance, serializedState: *const fmi3Byte, size: usize, FMUState: *mut fmi3FMUState) -> fmi3Status {
+pub unsafe extern "C" fn fmi3DeserializeFMUState(
+    instance: fmi3Instance,
+    serializedState: *const fmi3Byte,
+    size: usize,
+    FMUState: *mut fmi3FMUState,
+) -> fmi3Status {
     call(instance, "fmi3DeserializeFMUState", |inst| {
         if serializedState.is_null() || FMUState.is_null() {
             return Err(inst.fail("fmi3DeserializeFMUState: serializedState or FMUState is NULL"));
@@ -671,9 +693,9 @@ pub unsafe extern "C" fn fmi3DeserializeFMUState(instance: fmi3Instance, seriali
         let mine = inst.structural();
         let theirs: Vec<_> = mine.iter().map(|(n, _)| (*n, s.params.get(super::variables::VARIABLES.iter().find(|v| v.name == *n).unwrap().vr)[0])).collect();
         if mine != theirs {
-            return Err(inst.fail(&format!(
-                "fmi3DeserializeFMUState: the state is from an instance with structural parameters {theirs:?}, this one has {mine:?}"
-            )));
+            return Err(
+                inst.fail(&format!("fmi3DeserializeFMUState: the state is from an instance with structural parameters {theirs:?}, this one has {mine:?}"))
+            );
         }
         unsafe { inst.store_state("fmi3DeserializeFMUState", FMUState, s) }
     })
@@ -756,7 +778,12 @@ pub unsafe extern "C" fn fmi3GetIntervalFraction(
 const _: fmi3GetIntervalFractionTYPE = Some(fmi3GetIntervalFraction);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetShiftDecimal(instance: fmi3Instance, _valueReferences: *const fmi3ValueReference, _nValueReferences: usize, _shifts: *mut fmi3Float64) -> fmi3Status {
+pub unsafe extern "C" fn fmi3GetShiftDecimal(
+    instance: fmi3Instance,
+    _valueReferences: *const fmi3ValueReference,
+    _nValueReferences: usize,
+    _shifts: *mut fmi3Float64,
+) -> fmi3Status {
     unsupported(instance, "fmi3GetShiftDecimal", NO_CLOCKS)
 }
 const _: fmi3GetShiftDecimalTYPE = Some(fmi3GetShiftDecimal);
@@ -774,7 +801,12 @@ pub unsafe extern "C" fn fmi3GetShiftFraction(
 const _: fmi3GetShiftFractionTYPE = Some(fmi3GetShiftFraction);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetIntervalDecimal(instance: fmi3Instance, _valueReferences: *const fmi3ValueReference, _nValueReferences: usize, _intervals: *const fmi3Float64) -> fmi3Status {
+pub unsafe extern "C" fn fmi3SetIntervalDecimal(
+    instance: fmi3Instance,
+    _valueReferences: *const fmi3ValueReference,
+    _nValueReferences: usize,
+    _intervals: *const fmi3Float64,
+) -> fmi3Status {
     unsupported(instance, "fmi3SetIntervalDecimal", NO_CLOCKS)
 }
 const _: fmi3SetIntervalDecimalTYPE = Some(fmi3SetIntervalDecimal);
@@ -792,7 +824,12 @@ pub unsafe extern "C" fn fmi3SetIntervalFraction(
 const _: fmi3SetIntervalFractionTYPE = Some(fmi3SetIntervalFraction);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetShiftDecimal(instance: fmi3Instance, _valueReferences: *const fmi3ValueReference, _nValueReferences: usize, _shifts: *const fmi3Float64) -> fmi3Status {
+pub unsafe extern "C" fn fmi3SetShiftDecimal(
+    instance: fmi3Instance,
+    _valueReferences: *const fmi3ValueReference,
+    _nValueReferences: usize,
+    _shifts: *const fmi3Float64,
+) -> fmi3Status {
     unsupported(instance, "fmi3SetShiftDecimal", NO_CLOCKS)
 }
 const _: fmi3SetShiftDecimalTYPE = Some(fmi3SetShiftDecimal);
@@ -900,7 +937,11 @@ const _: fmi3GetNumberOfContinuousStatesTYPE = Some(fmi3GetNumberOfContinuousSta
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status {
-    unsupported(instance, "fmi3EnterStepMode", "Step Mode is entered from Event Mode, which this FMU does not have (hasEventMode = false); fmi3ExitInitializationMode enters Step Mode")
+    unsupported(
+        instance,
+        "fmi3EnterStepMode",
+        "Step Mode is entered from Event Mode, which this FMU does not have (hasEventMode = false); fmi3ExitInitializationMode enters Step Mode",
+    )
 }
 const _: fmi3EnterStepModeTYPE = Some(fmi3EnterStepMode);
 

@@ -54,9 +54,7 @@ impl Mode {
         1 << self as u32
     }
     pub fn from_u8(x: u8) -> Option<Mode> {
-        [Mode::Instantiated, Mode::ConfigurationMode, Mode::InitializationMode, Mode::StepMode, Mode::Terminated]
-            .get(x as usize)
-            .copied()
+        [Mode::Instantiated, Mode::ConfigurationMode, Mode::InitializationMode, Mode::StepMode, Mode::Terminated].get(x as usize).copied()
     }
 }
 
@@ -181,8 +179,7 @@ impl Instance {
         };
         // Failures (discarded steps, errors) always reach the host with their
         // reason; the rest only when asked for.
-        let enabled = status >= DISCARD
-            || (self.logging_on && (self.category_on(category) || self.category_on("logAll")));
+        let enabled = status >= DISCARD || (self.logging_on && (self.category_on(category) || self.category_on("logAll")));
         if enabled {
             log_raw(self.env, self.logger, status, category, message);
         }
@@ -201,11 +198,7 @@ impl Instance {
     pub fn guard(&self, function: &str, mask: u32) -> Result<(), fmi3Status> {
         if mask & self.mode.bit() == 0 {
             let allowed: Vec<String> = (0..5).filter_map(Mode::from_u8).filter(|m| mask & m.bit() != 0).map(|m| format!("{m:?}")).collect();
-            return Err(self.fail(&format!(
-                "{function}: illegal call sequence: not allowed in {:?}, only in {}",
-                self.mode,
-                allowed.join(", ")
-            )));
+            return Err(self.fail(&format!("{function}: illegal call sequence: not allowed in {:?}, only in {}", self.mode, allowed.join(", "))));
         }
         Ok(())
     }
@@ -225,12 +218,7 @@ impl Instance {
             let name = unsafe { CStr::from_ptr(c) }.to_string_lossy();
             match LOG_CATEGORIES.iter().position(|x| *x == name) {
                 Some(i) => selected.push(i),
-                None => {
-                    return Err(self.fail(&format!(
-                        "fmi3SetDebugLogging: unknown log category \"{name}\" (known: {})",
-                        LOG_CATEGORIES.join(", ")
-                    )))
-                }
+                None => return Err(self.fail(&format!("fmi3SetDebugLogging: unknown log category \"{name}\" (known: {})", LOG_CATEGORIES.join(", ")))),
             }
         }
         self.logging_on = on;
@@ -251,15 +239,7 @@ impl Instance {
         if self.sim.is_none() || self.stale {
             match self.params.build() {
                 Ok(sim) => {
-                    self.log(
-                        OK,
-                        &format!(
-                            "simulator set up: {} nodes in {}D, {} modes",
-                            sim.n_nodes(),
-                            sim.dimension(),
-                            sim.mode_frequencies().len()
-                        ),
-                    );
+                    self.log(OK, &format!("simulator set up: {} nodes in {}D, {} modes", sim.n_nodes(), sim.dimension(), sim.mode_frequencies().len()));
                     self.sim = Some(sim);
                     self.stale = false;
                 }
@@ -344,8 +324,7 @@ impl Instance {
         last_successful_time: *mut f64,
     ) -> R {
         self.guard("fmi3DoStep", mask::DO_STEP)?;
-        if event_handling_needed.is_null() || terminate_simulation.is_null() || early_return.is_null() || last_successful_time.is_null()
-        {
+        if event_handling_needed.is_null() || terminate_simulation.is_null() || early_return.is_null() || last_successful_time.is_null() {
             return Err(self.fail("fmi3DoStep: an output argument is NULL"));
         }
         let now = self.time();
@@ -415,26 +394,14 @@ impl Instance {
             total = total.saturating_add(self.params.size_of(v));
         }
         if total != n_values {
-            return Err(self.fail(&format!(
-                "{f}: nValues = {n_values}, but the {} value references hold {total} values",
-                vrs.len()
-            )));
+            return Err(self.fail(&format!("{f}: nValues = {n_values}, but the {} value references hold {total} values", vrs.len())));
         }
         Ok(())
     }
 
     /// # Safety
     /// `vrs` and `values` must point to `n_vrs` / `n_values` elements (or be null when that is 0).
-    pub unsafe fn get<T>(
-        &mut self,
-        f: &str,
-        ty: Type,
-        vrs: *const u32,
-        n_vrs: usize,
-        values: *mut T,
-        n_values: usize,
-        conv: impl Fn(f64) -> T,
-    ) -> R {
+    pub unsafe fn get<T>(&mut self, f: &str, ty: Type, vrs: *const u32, n_vrs: usize, values: *mut T, n_values: usize, conv: impl Fn(f64) -> T) -> R {
         self.guard(f, mask::GET)?;
         let vrs = self.value_references(f, vrs, n_vrs, values as *const T, n_values)?;
         // nValues is checked against the variables before `values` is touched.
@@ -480,9 +447,7 @@ impl Instance {
         let allowed = match (v.causality, v.variability) {
             (Causality::StructuralParameter, _) => Mode::Instantiated.bit() | Mode::ConfigurationMode.bit(),
             (Causality::Parameter, Variability::Fixed) => Mode::Instantiated.bit() | Mode::InitializationMode.bit(),
-            (Causality::Parameter, Variability::Tunable) => {
-                Mode::Instantiated.bit() | Mode::InitializationMode.bit() | Mode::StepMode.bit()
-            }
+            (Causality::Parameter, Variability::Tunable) => Mode::Instantiated.bit() | Mode::InitializationMode.bit() | Mode::StepMode.bit(),
             _ => return Err(format!("{} is a {:?} and cannot be set", v.name, v.causality)),
         };
         if allowed & self.mode.bit() == 0 {
@@ -663,12 +628,7 @@ impl Instance {
     }
 
     pub fn structural(&self) -> Vec<(&'static str, f64)> {
-        VARIABLES
-            .iter()
-            .enumerate()
-            .filter(|(_, v)| v.causality == Causality::StructuralParameter)
-            .map(|(i, v)| (v.name, self.params.values[i][0]))
-            .collect()
+        VARIABLES.iter().enumerate().filter(|(_, v)| v.causality == Causality::StructuralParameter).map(|(i, v)| (v.name, self.params.values[i][0])).collect()
     }
 }
 

@@ -28,13 +28,8 @@ impl Params {
         for line in text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')) {
             let mut words = line.split_whitespace();
             let name = words.next().unwrap();
-            let i = VARIABLES
-                .iter()
-                .position(|v| v.name == name && v.is_parameter())
-                .ok_or(format!("{name} is not a parameter"))?;
-            let values = words
-                .map(|w| w.parse::<f64>().map_err(|_| format!("{name}: {w} is not a number")))
-                .collect::<Result<Vec<_>, _>>()?;
+            let i = VARIABLES.iter().position(|v| v.name == name && v.is_parameter()).ok_or(format!("{name} is not a parameter"))?;
+            let values = words.map(|w| w.parse::<f64>().map_err(|_| format!("{name}: {w} is not a number"))).collect::<Result<Vec<_>, _>>()?;
             for x in &values {
                 super::instance::check_value(&VARIABLES[i], Some(*x)).map_err(|m| format!("{name} = {x}: {m}"))?;
             }
@@ -121,11 +116,7 @@ impl Params {
     pub fn solver(&self) -> SolverParams {
         SolverParams {
             reduction: if self.scalar(vr::REDUCTION) == 2.0 { Reduction::Full } else { Reduction::Modal },
-            integrator: if self.scalar(vr::INTEGRATOR) == 2.0 {
-                Integrator::NewmarkImplicit
-            } else {
-                Integrator::NewmarkExplicit
-            },
+            integrator: if self.scalar(vr::INTEGRATOR) == 2.0 { Integrator::NewmarkImplicit } else { Integrator::NewmarkExplicit },
             n_modes: self.count(vr::N_MODES),
             max_internal_step: self.scalar(vr::MAX_INTERNAL_STEP),
             substepping: true,

@@ -71,15 +71,7 @@ impl SpringForces {
         let mut rest: Vec<f64> = scene.springs.iter().map(|s| s.rest).collect();
         stiffness.resize(padded, 0.0);
         rest.resize(padded, 0.0);
-        SpringForces {
-            offsets,
-            springs,
-            stiffness,
-            rest,
-            g: vec![0.0; ns * scene.dim],
-            length_sq: vec![1.0; padded],
-            tension: vec![0.0; padded],
-        }
+        SpringForces { offsets, springs, stiffness, rest, g: vec![0.0; ns * scene.dim], length_sq: vec![1.0; padded], tension: vec![0.0; padded] }
     }
 
     /// Adds the spring forces to `f` (the free DOFs) and returns the elastic

@@ -175,9 +175,7 @@ impl FullSolver {
         self.symbolic
             .factorize_numeric_ldlt(&mut self.l_values, a, Side::Upper, regularization, Par::Seq, stack, Default::default())
             .map(|_| ())
-            .map_err(|_| SimError {
-                message: "full-space Newmark matrix is singular (springs in compression buckle); reduce maxInternalStep".into(),
-            })
+            .map_err(|_| SimError { message: "full-space Newmark matrix is singular (springs in compression buckle); reduce maxInternalStep".into() })
     }
 
     /// Solves with the last factorization, in place.

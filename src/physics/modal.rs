@@ -56,10 +56,8 @@ pub struct ModalSolver {
 impl ModalSolver {
     pub fn new(scene: &Scene, basis: ModalBasis, tunables: &Tunables, q_scale: f64) -> Self {
         let (n, r) = (basis.n, basis.r);
-        let req = StackReq::any_of(&[
-            lu_in_place_scratch::<usize, f64>(r, r, Par::Seq, Default::default()),
-            solve_in_place_scratch::<usize, f64>(r, 1, Par::Seq),
-        ]);
+        let req =
+            StackReq::any_of(&[lu_in_place_scratch::<usize, f64>(r, r, Par::Seq, Default::default()), solve_in_place_scratch::<usize, f64>(r, 1, Par::Seq)]);
         let mut s = ModalSolver {
             q: vec![0.0; r],
             qd: vec![0.0; r],

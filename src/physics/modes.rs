@@ -53,15 +53,15 @@ impl ModalBasis {
     pub fn lowest(scene: &Scene, pattern: &StiffnessPattern, k_vals: &[f64], r: usize) -> Result<Self, SimError> {
         let n = scene.n_dofs();
         if r > n {
-            return Err(SimError {
-                message: format!("nModes = {r} exceeds the {n} free degrees of freedom of the scene"),
-            });
+            return Err(SimError { message: format!("nModes = {r} exceeds the {n} free degrees of freedom of the scene") });
         }
         if n > PARTIAL_MIN_DOFS && r * PARTIAL_MAX_FRACTION <= n {
             match Self::partial(scene, pattern, k_vals, r) {
                 Ok(basis) => Ok(basis),
                 // Where the dense solver can run, it settles what the partial one cannot.
-                Err(e) if n <= MAX_DENSE_DOFS => Self::dense(scene, pattern, k_vals, r).map_err(|d| SimError { message: format!("{}; {}", e.message, d.message) }),
+                Err(e) if n <= MAX_DENSE_DOFS => {
+                    Self::dense(scene, pattern, k_vals, r).map_err(|d| SimError { message: format!("{}; {}", e.message, d.message) })
+                }
                 Err(e) => Err(e),
             }
         } else {
@@ -91,9 +91,7 @@ impl ModalBasis {
                 kt[(c, row)] = v;
             }
         }
-        let evd = kt.self_adjoint_eigen(Side::Lower).map_err(|e| SimError {
-            message: format!("eigen decomposition of the stiffness matrix failed: {e:?}"),
-        })?;
+        let evd = kt.self_adjoint_eigen(Side::Lower).map_err(|e| SimError { message: format!("eigen decomposition of the stiffness matrix failed: {e:?}") })?;
         let s = evd.S();
         let lambda_max = if n > 0 { s[n - 1].abs() } else { 0.0 };
         Self::from_pairs(n, r, (0..r).map(|j| s[j]), lambda_max, evd.U(), &inv_sqrt_m)
@@ -164,7 +162,11 @@ impl ModalBasis {
         let lambda = values
             .map(|l| {
                 // Round-off around a zero eigenvalue (mechanism, rigid mode) may come out slightly negative.
-                if l < 0.0 && l.abs() <= 1e-10 * lambda_max { 0.0 } else { l }
+                if l < 0.0 && l.abs() <= 1e-10 * lambda_max {
+                    0.0
+                } else {
+                    l
+                }
             })
             .collect::<Vec<_>>();
         if let Some(&l) = lambda.iter().find(|l| !(**l >= 0.0)) {
@@ -200,7 +202,14 @@ impl ModalBasis {
 /// The `r` lowest eigenpairs of K~ restricted to the DOFs `block` (ascending
 /// values; orthonormal vectors over the block), by Krylov-Schur on the
 /// shift-inverted operator.
-fn coupled_block_lowest(pattern: &StiffnessPattern, k_vals: &[f64], mass: &[f64], block: &[usize], r: usize, diag_max: f64) -> Result<(Vec<f64>, Mat<f64>), SimError> {
+fn coupled_block_lowest(
+    pattern: &StiffnessPattern,
+    k_vals: &[f64],
+    mass: &[f64],
+    block: &[usize],
+    r: usize,
+    diag_max: f64,
+) -> Result<(Vec<f64>, Mat<f64>), SimError> {
     let nb = block.len();
     if r == 0 {
         return Ok((Vec::new(), Mat::zeros(nb, 0)));
@@ -224,9 +233,9 @@ fn coupled_block_lowest(pattern: &StiffnessPattern, k_vals: &[f64], mass: &[f64]
         col_ptr.push(row_idx.len());
     }
     let sym = SymbolicSparseColMatRef::new_checked(nb, nb, &col_ptr, None, &row_idx);
-    let llt = SparseColMatRef::new(sym, &vals).sp_cholesky(Side::Upper).map_err(|e| SimError {
-        message: format!("the stiffness matrix at rest is not positive semi-definite (sparse Cholesky: {e:?})"),
-    })?;
+    let llt = SparseColMatRef::new(sym, &vals)
+        .sp_cholesky(Side::Upper)
+        .map_err(|e| SimError { message: format!("the stiffness matrix at rest is not positive semi-definite (sparse Cholesky: {e:?})") })?;
     let mut op = ShiftInvert { llt, sqrt_m: block.iter().map(|&k| mass[k].sqrt()).collect(), scale: 1.0 };
     // Scale A so its largest eigenvalue is near 1 and the absolute residual
     // tolerance of the Krylov-Schur solver is a relative one: a few inverse
@@ -250,7 +259,10 @@ fn coupled_block_lowest(pattern: &StiffnessPattern, k_vals: &[f64], mass: &[f64]
     let info = partial_self_adjoint_eigen(vectors.as_mut(), &mut values, &op, v0.as_ref(), 1e-12, Par::Seq, MemStack::new(&mut mem), params);
     if info.n_converged_eigen < r {
         return Err(SimError {
-            message: format!("the partial eigensolver found {} of the nModes = {r} lowest modes; keep fewer modes or use reduction = full", info.n_converged_eigen),
+            message: format!(
+                "the partial eigensolver found {} of the nModes = {r} lowest modes; keep fewer modes or use reduction = full",
+                info.n_converged_eigen
+            ),
         });
     }
     // Ascending lambda = sigma + 1 / mu, with mu unscaled.

@@ -85,12 +85,7 @@ pub struct Tunables {
 }
 
 /// Names of the canonical scenes of METHOD.md section 5.
-pub const SCENE_NAMES: [&str; 4] = [
-    "paper-2d-top-row",
-    "paper-2d-top-corners",
-    "paper-3d-sheet",
-    "cloth-3d",
-];
+pub const SCENE_NAMES: [&str; 4] = ["paper-2d-top-row", "paper-2d-top-corners", "paper-3d-sheet", "cloth-3d"];
 
 impl SceneParams {
     /// The defaults of METHOD.md section 5 on an `nx` x `ny` grid in `dimension` D.
@@ -132,24 +127,13 @@ impl Default for SceneParams {
 impl Default for SolverParams {
     /// Two modes, explicit Newmark, internal steps of at most 10 ms.
     fn default() -> Self {
-        SolverParams {
-            reduction: Reduction::Modal,
-            integrator: Integrator::NewmarkExplicit,
-            n_modes: 2,
-            max_internal_step: 0.01,
-            substepping: true,
-        }
+        SolverParams { reduction: Reduction::Modal, integrator: Integrator::NewmarkExplicit, n_modes: 2, max_internal_step: 0.01, substepping: true }
     }
 }
 
 impl Tunables {
     /// Earth gravity along -y, no damping, every weight 1 (the physical model).
     pub fn physical(n_modes: usize) -> Self {
-        Tunables {
-            gravity: [0.0, -9.81, 0.0],
-            damping_alpha: 0.0,
-            damping_beta: 0.0,
-            mode_weights: vec![1.0; n_modes],
-        }
+        Tunables { gravity: [0.0, -9.81, 0.0], damping_alpha: 0.0, damping_beta: 0.0, mode_weights: vec![1.0; n_modes] }
     }
 }

@@ -120,17 +120,7 @@ impl Scene {
                 springs.push(Spring { a: s, b: anchor, k: p.aux_stiffness, rest: h });
             }
         }
-        Ok(Scene {
-            dim: d,
-            nx,
-            ny,
-            n_nodes,
-            n_free,
-            slot_of_node,
-            rest,
-            dof_mass: vec![p.node_mass; n_free * d],
-            springs,
-        })
+        Ok(Scene { dim: d, nx, ny, n_nodes, n_free, slot_of_node, rest, dof_mass: vec![p.node_mass; n_free * d], springs })
     }
 }
 

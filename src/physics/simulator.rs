@@ -116,11 +116,7 @@ impl Simulator {
         let (model, reported_basis, omega_sq_bound) = match solver.reduction {
             Reduction::Modal => {
                 let basis = basis.expect("modal reduction has modes");
-                let bound = if basis.r <= DENSE_BOUND_MODES {
-                    taut_reduced_bound(&scene, &basis)?
-                } else {
-                    omega_sq_bound_full(&scene)
-                };
+                let bound = if basis.r <= DENSE_BOUND_MODES { taut_reduced_bound(&scene, &basis)? } else { omega_sq_bound_full(&scene) };
                 let q_scale = total_mass.sqrt() * length_scale.max(f64::MIN_POSITIVE);
                 (Model::Modal(ModalSolver::new(&scene, basis, tunables, q_scale)), None, bound)
             }
@@ -135,7 +131,13 @@ impl Simulator {
             velocities: vec![0.0; scene.n_nodes * scene.dim],
             dof_velocities: vec![0.0; n],
             modal_coordinates: vec![0.0; r],
-            backup: vec![0.0; 3 * match &model { Model::Modal(m) => m.q.len(), Model::Full(f) => f.u.len() }],
+            backup: vec![
+                0.0;
+                3 * match &model {
+                    Model::Modal(m) => m.q.len(),
+                    Model::Full(f) => f.u.len(),
+                }
+            ],
             scene,
             solver: solver.clone(),
             tunables: tunables.clone(),
@@ -331,7 +333,8 @@ impl Simulator {
                     b.project_displacement(&self.scene.dof_mass, &f.u, &mut self.modal_coordinates);
                 }
                 let g = &self.tunables.gravity;
-                let work: f64 = f.u.chunks_exact(d).zip(self.scene.dof_mass.chunks_exact(d)).map(|(u, m)| (0..d).map(|i| m[i] * g[i] * u[i]).sum::<f64>()).sum();
+                let work: f64 =
+                    f.u.chunks_exact(d).zip(self.scene.dof_mass.chunks_exact(d)).map(|(u, m)| (0..d).map(|i| m[i] * g[i] * u[i]).sum::<f64>()).sum();
                 (&f.x, f.elastic, -work)
             }
         };
@@ -484,8 +487,6 @@ fn taut_reduced_bound(scene: &Scene, basis: &ModalBasis) -> Result<f64, SimError
     let mut work = vec![0.0; 6 * r];
     add_reduced_tangent(scene, &scene.rest, &basis.phi, r, true, &mut kr, &mut work);
     let m = faer::Mat::<f64>::from_fn(r, r, |i, j| kr[j * r + i]);
-    let ev = m
-        .self_adjoint_eigenvalues(Side::Lower)
-        .map_err(|e| SimError { message: format!("eigenvalues of the reduced stiffness failed: {e:?}") })?;
+    let ev = m.self_adjoint_eigenvalues(Side::Lower).map_err(|e| SimError { message: format!("eigenvalues of the reduced stiffness failed: {e:?}") })?;
     Ok(ev.last().copied().unwrap_or(0.0).max(0.0))
 }

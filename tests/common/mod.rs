@@ -57,9 +57,8 @@ impl Fmu {
         let log = Box::<Log>::default();
         let name = CString::new(name).unwrap();
         let token = CString::new(INSTANTIATION_TOKEN).unwrap();
-        let inst = unsafe {
-            fmi3InstantiateCoSimulation(name.as_ptr(), token.as_ptr(), null(), false, false, false, false, null(), 0, log.env(), Some(logger), None)
-        };
+        let inst =
+            unsafe { fmi3InstantiateCoSimulation(name.as_ptr(), token.as_ptr(), null(), false, false, false, false, null(), 0, log.env(), Some(logger), None) };
         assert!(!inst.is_null(), "{:?}", log.take());
         Fmu { inst, log }
     }
@@ -233,11 +232,7 @@ pub fn packed_fmu() -> PathBuf {
     if !fresh {
         let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
         let status = Command::new(cargo).current_dir(root).args(["xtask", "fmu"]).status();
-        assert!(
-            status.is_ok_and(|s| s.success()),
-            "{} is missing or stale and `cargo xtask fmu` failed; run it by hand to see why",
-            fmu.display()
-        );
+        assert!(status.is_ok_and(|s| s.success()), "{} is missing or stale and `cargo xtask fmu` failed; run it by hand to see why", fmu.display());
     }
     fmu
 }

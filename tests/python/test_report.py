@@ -1,23 +1,35 @@
-"""Checks of the error-against-run-time study in quick mode
+"""Checks of the error-against-run-time study: the quick one
 (`cargo xtask report --quick`), which `cargo xtask test` runs first and
-points to with MMS_REPORT_DIR."""
+points to with MMS_REPORT_DIR, and the full one committed in report/."""
 import csv
 import math
 import os
+import re
 from pathlib import Path
 
 import pytest
 
+CANONICAL_SCENES = {"paper-2d-top-row", "paper-2d-top-corners", "paper-3d-sheet", "cloth-3d"}
 COLUMNS = ["scene", "method", "integrator", "modes", "step", "internal_steps", "setup_s",
            "run_s_per_sim_s", "error", "max_node_error", "stable"]
 
 
-@pytest.fixture(scope="module")
-def rows():
-    folder = os.environ.get("MMS_REPORT_DIR")
-    if not folder:
+COMMITTED = Path(__file__).resolve().parents[2] / "report"
+
+
+@pytest.fixture(scope="module", params=["quick", "committed"])
+def folder(request):
+    if request.param == "committed":
+        return COMMITTED
+    quick = os.environ.get("MMS_REPORT_DIR")
+    if not quick:
         pytest.fail("MMS_REPORT_DIR is not set: run through `cargo xtask test`, which makes the quick report")
-    path = Path(folder) / "error_vs_runtime.csv"
+    return Path(quick)
+
+
+@pytest.fixture(scope="module")
+def rows(folder):
+    path = folder / "error_vs_runtime.csv"
     with open(path, newline="") as f:
         reader = csv.DictReader(f)
         assert reader.fieldnames[:len(COLUMNS)] == COLUMNS
@@ -35,8 +47,11 @@ def test_every_way_of_running_is_there(rows):
 
 
 def test_stable_runs_have_finite_errors_and_times(rows):
+    # Runs left out on purpose (too costly to start, or stopped at the wall
+    # time budget) say so; of the others nearly all must be stable.
+    run = [r for r in rows if not r["note"].startswith(("not run", "over the time budget"))]
     stable = [r for r in rows if r["stable"] == "true"]
-    assert len(stable) >= len(rows) * 0.9
+    assert len(stable) >= len(run) * 0.9
     for r in stable:
         for column in ("error", "max_node_error", "run_s_per_sim_s", "setup_s"):
             assert math.isfinite(float(r[column])), (r, column)
@@ -48,20 +63,64 @@ def test_stable_runs_have_finite_errors_and_times(rows):
             assert r["note"], r
 
 
-def test_all_modes_modal_matches_full_space_to_round_off(rows):
-    all_modes = [r for r in rows if r["method"] == "modal" and r["modes"] == r["dofs"]]
+def reference_table(folder):
+    """The References table of the report's README, a dict of cells per scene."""
+    text = (folder / "README.md").read_text()
+    table = text.split("## References", 1)[1].split("\n## ", 1)[0]
+    lines = [l for l in table.splitlines() if l.startswith("| ") and not l.startswith("| scene")]
+    keys = ["scene", "dofs", "dt", "self", "halved", "smallest", "ratio", "resolved_until", "self_there", "smallest_there", "ratio_there"]
+    return {cells[0]: dict(zip(keys, cells)) for cells in ([c.strip() for c in l.strip("|").split("|")] for l in lines)}
+
+
+def sensitive(reference):
+    """A trajectory is sensitive where halving the reference's step again does
+    not shrink its own error as second order would (about 4x): a round-off
+    difference then grows during the run (cloth-3d buckles as it rebounds)."""
+    return float(reference["halved"]) > float(reference["self"]) / 3
+
+
+def test_all_modes_modal_matches_full_space_to_round_off(rows, folder):
+    references = reference_table(folder)
+    all_modes = [r for r in rows if r["method"] == "modal" and r["modes"] == r["dofs"] and r["stable"] == "true"]
     assert len(all_modes) >= 4
     for r in all_modes:
-        assert float(r["vs_full"]) < 1e-10, r
         full = next(f for f in rows if f["method"] == "full" and f["scene"] == r["scene"]
                     and f["integrator"] == r["integrator"] and f["step"] == r["step"] and not f["note"])
+        if sensitive(references[r["scene"]]):
+            # Same algebra in another basis: round-off apart, then that
+            # difference grows with the trajectory's own sensitivity; it
+            # must still be far below the error of either run.
+            assert float(r["vs_full"]) < float(full["error"]) / 100, r
+            continue
+        assert float(r["vs_full"]) < 1e-10, r
         assert float(r["error"]) == pytest.approx(float(full["error"]), rel=1e-8)
 
 
-def test_report_readme_and_plots(rows):
-    folder = Path(os.environ["MMS_REPORT_DIR"])
+def test_report_readme_and_plots(rows, folder):
     text = (folder / "README.md").read_text()
     for scene in {r["scene"] for r in rows}:
         assert f"## {scene}" in text
         assert (folder / f"{scene}.png").stat().st_size > 10_000
     assert "Pareto front" in text and "Speed-up" in text
+
+
+def test_references_are_ten_times_more_accurate_than_the_errors_they_measure(rows, folder):
+    """The References table: on the canonical scenes the reference's own
+    error (against half its step) is 10x below the smallest E over the whole
+    run, and halving the step again shrinks it as a second-order method
+    should; every scene states the window over which that holds."""
+    text = (folder / "README.md").read_text()
+    simulated = float(re.search(r"Simulated time ([0-9.]+) s", text).group(1))
+    references = reference_table(folder)
+    assert set(references) == {r["scene"] for r in rows}
+    for scene, ref in references.items():
+        assert float(ref["smallest_there"]) >= 10 * float(ref["self_there"]), ref
+        assert {float(r["resolved_until_s"]) for r in rows if r["scene"] == scene} == {float(ref["resolved_until"])}
+        if scene in CANONICAL_SCENES:
+            assert float(ref["smallest"]) >= 10 * float(ref["self"]), ref
+            assert float(ref["resolved_until"]) == pytest.approx(simulated), ref
+        if scene.startswith("paper-"):
+            assert not sensitive(ref), ref
+    for r in rows:
+        if r["stable"] == "true":
+            assert math.isfinite(float(r["error_resolved"])), r

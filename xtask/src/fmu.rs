@@ -37,9 +37,7 @@ fn parse(args: &[String]) -> Result<Options, String> {
             "--ny" => o.ny = Some(number(value()?)?),
             "--modes" => o.modes = Some(number(value()?)?),
             "--out" => o.out = Some(PathBuf::from(value()?)),
-            "-h" | "--help" => {
-                return Err("usage: cargo xtask fmu [--scene NAME] [--nx N] [--ny N] [--modes R] [--out PATH]".into())
-            }
+            "-h" | "--help" => return Err("usage: cargo xtask fmu [--scene NAME] [--nx N] [--ny N] [--modes R] [--out PATH]".into()),
             other => return Err(format!("unknown option {other}")),
         }
     }
@@ -69,9 +67,7 @@ pub fn main(args: &[String]) -> Result<(), String> {
 
     let mut overrides: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     if let Some(s) = &o.scene {
-        overrides = spec
-            .scene(s)
-            .ok_or(format!("unknown scene {s}; known: {}", spec.scene_names().join(", ")))?;
+        overrides = spec.scene(s).ok_or(format!("unknown scene {s}; known: {}", spec.scene_names().join(", ")))?;
     }
     for (name, v) in [("nx", o.nx), ("ny", o.ny), ("nModes", o.modes)] {
         if let Some(v) = v {

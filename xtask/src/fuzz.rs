@@ -64,10 +64,7 @@ fn ensure_cargo_fuzz() -> Result<(), String> {
         return Ok(());
     }
     eprintln!("fuzz: installing cargo-fuzz");
-    let status = Command::new(cargo())
-        .args(["install", "cargo-fuzz", "--locked"])
-        .status()
-        .map_err(|e| format!("cannot run cargo install: {e}"))?;
+    let status = Command::new(cargo()).args(["install", "cargo-fuzz", "--locked"]).status().map_err(|e| format!("cannot run cargo install: {e}"))?;
     if !status.success() {
         return Err("cargo install cargo-fuzz --locked failed".into());
     }

@@ -40,10 +40,8 @@ fn fmu_dir(root: &Path) -> PathBuf {
 fn scene_names(root: &Path) -> Result<Vec<String>, String> {
     let path = root.join("modelDescription/variables.toml");
     let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let names: Vec<String> = text
-        .lines()
-        .filter_map(|l| l.trim().strip_prefix("[scenes.")?.strip_suffix(']').map(|s| s.trim_matches('"').to_string()))
-        .collect();
+    let names: Vec<String> =
+        text.lines().filter_map(|l| l.trim().strip_prefix("[scenes.")?.strip_suffix(']').map(|s| s.trim_matches('"').to_string())).collect();
     if names.is_empty() {
         return Err(format!("no [scenes.NAME] table in {}", path.display()));
     }
@@ -85,14 +83,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
 /// download fails, the system's libxml2 (Debian's libxml2-dev, installed by
 /// setup) is linked into that directory and the build retried.
 fn prepare_xsd(root: &Path, test_args: &[&str]) -> Result<(), String> {
-    let build = || {
-        Command::new(cargo())
-            .current_dir(root)
-            .args(test_args)
-            .arg("--no-run")
-            .status()
-            .map_err(|e| format!("cannot run cargo: {e}"))
-    };
+    let build = || Command::new(cargo()).current_dir(root).args(test_args).arg("--no-run").status().map_err(|e| format!("cannot run cargo: {e}"));
     if build()?.success() {
         return Ok(());
     }
@@ -142,6 +133,20 @@ pub fn test(args: &[String]) -> Result<(), String> {
 
     let mut failures = Vec::new();
 
+    step("cargo fmt --check (rustfmt.toml)");
+    let rustfmt = Command::new(cargo()).args(["fmt", "--version"]).output().is_ok_and(|o| o.status.success());
+    if rustfmt {
+        for dir in [root.clone(), root.join("fuzz")] {
+            let status =
+                Command::new(cargo()).current_dir(&dir).args(["fmt", "--all", "--check"]).status().map_err(|e| format!("cannot run cargo fmt: {e}"))?;
+            if !status.success() {
+                failures.push(format!("formatting differs from rustfmt in {} (run `cargo fmt --all` there)", dir.display()));
+            }
+        }
+    } else {
+        eprintln!("rustfmt is not installed: formatting not checked");
+    }
+
     // Right after the FMU build: the fuzz targets load its library as it is
     // (the test build below compiles the crate with other features).
     step(&format!("fuzzing: cargo xtask fuzz --seconds {FUZZ_SECONDS}"));
@@ -162,11 +167,7 @@ pub fn test(args: &[String]) -> Result<(), String> {
     // a second time, most of CI's time).
     let test_args = ["test", "--release", TEST_CARGO_ARGS[0], TEST_CARGO_ARGS[1], TEST_CARGO_ARGS[2]];
     prepare_xsd(&root, &test_args)?;
-    let status = Command::new(cargo())
-        .current_dir(&root)
-        .args(test_args)
-        .status()
-        .map_err(|e| format!("cannot run cargo: {e}"))?;
+    let status = Command::new(cargo()).current_dir(&root).args(test_args).status().map_err(|e| format!("cannot run cargo: {e}"))?;
     if !status.success() {
         failures.push(format!("cargo test ({status})"));
     }

@@ -16,12 +16,7 @@ use std::process::{Command, Stdio};
 const DEBIAN_PACKAGES: &[&str] = &["libclang-dev", "libxml2-dev", "valgrind", "libclang-rt-dev"];
 
 /// Python packages: (distribution name as pip knows it, requirement to install).
-const PYTHON_PACKAGES: &[(&str, &str)] = &[
-    ("fmpy", "fmpy==0.3.32"),
-    ("pytest", "pytest"),
-    ("numpy", "numpy"),
-    ("matplotlib", "matplotlib"),
-];
+const PYTHON_PACKAGES: &[(&str, &str)] = &[("fmpy", "fmpy==0.3.32"), ("pytest", "pytest"), ("numpy", "numpy"), ("matplotlib", "matplotlib")];
 
 /// The version of fmpy the tests are written against.
 const FMPY_VERSION: &str = "0.3.32";
@@ -55,11 +50,7 @@ fn debian_installed(pkg: &str) -> bool {
 }
 
 fn is_root() -> bool {
-    Command::new("id")
-        .arg("-u")
-        .output()
-        .map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
-        .unwrap_or(false)
+    Command::new("id").arg("-u").output().map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0").unwrap_or(false)
 }
 
 fn debian_packages() -> Result<(), String> {
@@ -133,9 +124,7 @@ fn venv() -> Result<(), String> {
 
 /// Installed version of each distribution, as the venv's Python sees it.
 fn installed_version(dist: &str) -> Option<String> {
-    let code = format!(
-        "import importlib.metadata as m\ntry:\n    print(m.version({dist:?}))\nexcept m.PackageNotFoundError:\n    pass\n"
-    );
+    let code = format!("import importlib.metadata as m\ntry:\n    print(m.version({dist:?}))\nexcept m.PackageNotFoundError:\n    pass\n");
     let out = Command::new(python()).args(["-c", &code]).output().ok()?;
     let v = String::from_utf8_lossy(&out.stdout).trim().to_string();
     (out.status.success() && !v.is_empty()).then_some(v)
