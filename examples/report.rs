@@ -90,18 +90,18 @@ fn simulate(p: &SceneParams, s: &SolverParams, h: f64, seconds: f64, budget_s: f
     Ok(Trajectory { frames, setup_s, run_s: t1.elapsed().as_secs_f64(), internal_steps: internal_steps / (per_frame * n_frames).max(1) })
 }
 
-/// E (METHOD.md section 6; equal node masses cancel) and the largest node distance error.
-fn error(run: &[Vec<f64>], reference: &[Vec<f64>], d: usize) -> (f64, f64) {
-    let (mut num, mut den, mut max_node) = (0.0, 0.0, 0.0f64);
-    for (x, xr) in run.iter().zip(reference) {
-        for i in 0..x.len() / d {
-            let e2: f64 = (0..d).map(|c| (x[i * d + c] - xr[i * d + c]).powi(2)).sum();
-            num += e2;
-            max_node = max_node.max(e2.sqrt());
-            den += (0..d).map(|c| (xr[i * d + c] - reference[0][i * d + c]).powi(2)).sum::<f64>();
-        }
-    }
-    ((num / den).sqrt(), max_node)
+/// E (METHOD.md section 6; equal node masses cancel) over all output times.
+fn error(run: &[Vec<f64>], reference: &[Vec<f64>]) -> f64 {
+    errors_by_window(run, reference).last().copied().unwrap_or(f64::NAN)
+}
+
+/// The largest distance between a node and its reference position over all output times.
+fn max_node_error(run: &[Vec<f64>], reference: &[Vec<f64>], d: usize) -> f64 {
+    run.iter()
+        .zip(reference)
+        .flat_map(|(x, xr)| x.chunks_exact(d).zip(xr.chunks_exact(d)))
+        .map(|(a, b)| a.iter().zip(b).map(|(p, q)| (p - q).powi(2)).sum::<f64>().sqrt())
+        .fold(0.0, f64::max)
 }
 
 /// E over growing windows: element k - 1 is E over the first k output times
@@ -223,9 +223,9 @@ fn main() {
         let quartered =
             simulate(p, &full(Integrator::NewmarkExplicit, reference_dt / 4.0), reference_dt / 4.0, seconds, f64::INFINITY).expect("reference check failed");
         bar.inc(1);
-        let (self_error, _) = error(&reference.frames, &halved.frames, p.dimension);
-        let (halved_error, _) = error(&halved.frames, &quartered.frames, p.dimension);
         let self_by_window = errors_by_window(&reference.frames, &halved.frames);
+        let self_error = *self_by_window.last().unwrap();
+        let halved_error = error(&halved.frames, &quartered.frames);
         let mut run_by_window: Vec<Vec<f64>> = Vec::new();
         let first = rows.len();
         // Full-space trajectories by (integrator, step), for the vs_full column.
@@ -278,18 +278,19 @@ fn main() {
             };
             match last.unwrap() {
                 Ok(t) => {
-                    let (e, m) = error(&t.frames, &reference.frames, p.dimension);
+                    let by_window = errors_by_window(&t.frames, &reference.frames);
+                    let e = *by_window.last().unwrap();
                     row.internal_steps = t.internal_steps;
                     row.setup_s = t.setup_s;
                     row.run_s_per_sim_s = median(times);
                     row.error = e;
-                    row.max_node_error = m;
-                    run_by_window.push(errors_by_window(&t.frames, &reference.frames));
+                    row.max_node_error = max_node_error(&t.frames, &reference.frames, p.dimension);
+                    run_by_window.push(by_window);
                     row.stable = e.is_finite();
                     if method == "full" && plan.note.is_empty() {
                         full_runs.push((s.integrator, plan.step_label.clone(), t.frames));
                     } else if let Some((_, _, f)) = full_runs.iter().find(|(i, l, _)| *i == s.integrator && *l == plan.step_label) {
-                        row.vs_full = error(&t.frames, f, p.dimension).0;
+                        row.vs_full = error(&t.frames, f);
                     }
                 }
                 Err(e) => {

@@ -47,9 +47,8 @@ fn parse(args: &[String]) -> Result<Options, String> {
 /// Builds the FMU's shared library (release, the product's features only)
 /// and returns its path.
 pub fn build_library(root: &Path) -> Result<PathBuf, String> {
-    let target = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or(root.join("target"));
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
+    let target = crate::setup::target_dir(root);
+    let status = Command::new(crate::setup::cargo())
         .current_dir(root)
         .args(["build", "--release", "--lib", "--package", "modal_mass_spring"])
         .status()
@@ -96,7 +95,7 @@ pub fn main(args: &[String]) -> Result<(), String> {
     let starts = spec.start_values_text(&overrides)?;
 
     let lib = build_library(&root)?;
-    let target = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or(root.join("target"));
+    let target = crate::setup::target_dir(&root);
     let binary = std::fs::read(&lib).map_err(|e| format!("{}: {e}", lib.display()))?;
 
     let out = o.out.clone().unwrap_or_else(|| {

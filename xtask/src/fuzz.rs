@@ -15,11 +15,12 @@
 //! - Inputs that fail are left in `fuzz/artifacts/TARGET/`; the corpus grows
 //!   in `fuzz/corpus/TARGET/` from the seeds in `fuzz/seeds/TARGET/`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
 use crate::setup;
+use crate::setup::{cargo, target_dir};
 
 const TARGETS: &[&str] = &["deserialize", "call_sequence"];
 const DEFAULT_SECONDS: u64 = 30;
@@ -54,10 +55,6 @@ pub fn main(args: &[String]) -> Result<(), String> {
     Ok(())
 }
 
-fn cargo() -> String {
-    std::env::var("CARGO").unwrap_or_else(|_| "cargo".into())
-}
-
 fn ensure_cargo_fuzz() -> Result<(), String> {
     let ok = Command::new(cargo()).args(["fuzz", "--version"]).stdout(Stdio::null()).stderr(Stdio::null()).status();
     if ok.map(|s| s.success()).unwrap_or(false) {
@@ -83,14 +80,6 @@ fn system_libfuzzer() -> Option<PathBuf> {
         .collect();
     found.sort();
     found.pop()
-}
-
-fn target_dir(root: &Path) -> PathBuf {
-    match std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from) {
-        Some(p) if p.is_absolute() => p,
-        Some(p) => root.join(p),
-        None => root.join("target"),
-    }
 }
 
 /// Executions and seconds from libFuzzer's "Done 12345 runs in 30 second(s)".

@@ -21,7 +21,7 @@ pub fn run(quick: bool, out: &str, cargo_args: &[&str]) -> Result<(), String> {
     let root = crate::setup::root();
     // Built, then run: `cargo run` cannot take --workspace, which
     // `cargo xtask test` passes so that the build reuses the test build.
-    let status = Command::new(env!("CARGO"))
+    let status = Command::new(crate::setup::cargo())
         .current_dir(&root)
         .args(["build", "--release", "--example", "report"])
         .args(cargo_args)
@@ -30,7 +30,7 @@ pub fn run(quick: bool, out: &str, cargo_args: &[&str]) -> Result<(), String> {
     if !status.success() {
         return Err("cargo build --example report failed".into());
     }
-    let target = std::env::var_os("CARGO_TARGET_DIR").map(std::path::PathBuf::from).map_or_else(|| root.join("target"), |t| root.join(t));
+    let target = crate::setup::target_dir(&root);
     let mut cmd = Command::new(target.join("release/examples/report"));
     cmd.current_dir(&root);
     cmd.args(["--out", out]);

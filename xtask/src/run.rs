@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
+use crate::setup::{cargo, target_dir};
 use crate::{fmu, fuzz, setup, valgrind};
 
 /// Packages and features of every cargo build of the test stage: the same
@@ -23,14 +24,6 @@ const TEST_CARGO_ARGS: [&str; 3] = ["--workspace", "--features", "modal_mass_spr
 
 /// Fuzzing time per target in `cargo xtask test` (CI): bounded, see README.
 const FUZZ_SECONDS: u64 = 30;
-
-fn target_dir(root: &Path) -> PathBuf {
-    match std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from) {
-        Some(p) if p.is_absolute() => p,
-        Some(p) => root.join(p),
-        None => root.join("target"),
-    }
-}
 
 fn fmu_dir(root: &Path) -> PathBuf {
     target_dir(root).join("fmu")
@@ -46,10 +39,6 @@ fn scene_names(root: &Path) -> Result<Vec<String>, String> {
         return Err(format!("no [scenes.NAME] table in {}", path.display()));
     }
     Ok(names)
-}
-
-fn cargo() -> String {
-    std::env::var("CARGO").unwrap_or_else(|_| "cargo".into())
 }
 
 fn step(title: &str) {

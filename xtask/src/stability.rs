@@ -8,7 +8,7 @@ pub fn main(args: &[String]) -> Result<(), String> {
     if !args.is_empty() {
         return Err("usage: cargo xtask stability".into());
     }
-    let status = Command::new(env!("CARGO"))
+    let status = Command::new(crate::setup::cargo())
         .current_dir(crate::setup::root())
         .args(["test", "--release", "--test", "stability", "--", "--nocapture"])
         .env("MMS_STABILITY_WRITE", "1")

@@ -26,9 +26,8 @@ pub fn run(cycles: &str, cargo_args: &[&str]) -> Result<(), String> {
     if Command::new("valgrind").arg("--version").output().is_err() {
         return Err("valgrind is not installed (cargo xtask setup installs it)".into());
     }
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     // The release profile, as the FMU is built (and with no second build of faer).
-    let out = Command::new(&cargo)
+    let out = Command::new(setup::cargo())
         .current_dir(&root)
         .args(["build", "--release", "--example", "fmi_cycles", "--message-format=json-render-diagnostics"])
         .args(cargo_args)
