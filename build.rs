@@ -1,4 +1,5 @@
-//! Generates the Rust variable table from modelDescription/variables.toml and
+//! Generates the Rust variable table and option enumerations from
+//! modelDescription/variables.toml and
 //! a C header of the exported fmi3 functions (cbindgen), both into OUT_DIR.
 
 #[path = "modelDescription/generate.rs"]
@@ -25,6 +26,7 @@ fn main() {
     // Fail the build, not the importer, if the defaults do not form a valid description.
     spec.model_description_xml(&Default::default()).unwrap_or_else(|e| panic!("{e}"));
     std::fs::write(out.join("variables.rs"), spec.rust_source()).unwrap();
+    std::fs::write(out.join("options.rs"), spec.options_source()).unwrap();
 
     // Only the exports file is parsed, so this stays cheap.
     let config = cbindgen::Config { usize_is_size_t: true, ..Default::default() };

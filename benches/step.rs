@@ -17,29 +17,27 @@ use fmi_sys::fmi3::*;
 use modal_mass_spring::fmi::exports::*;
 use modal_mass_spring::fmi::variables::{vr, INSTANTIATION_TOKEN};
 use modal_mass_spring::physics::*;
+use modal_mass_spring::scenes;
 
 const PER_CALL: usize = 100;
 
 /// A simulator whose internal step is `dt` whatever the call length.
-fn simulator(p: &SceneParams, s: &SolverParams) -> (Simulator, f64) {
-    let probe = Simulator::new(p, s, &Tunables::physical(s.n_modes)).unwrap();
+fn simulator(p: &Grid, s: &SolverParams) -> (Simulator, f64) {
+    let probe = Simulator::new(p.build().unwrap(), s, &Loads::physical(s.n_modes)).unwrap();
     let dt = probe.max_stable_step().min(1e-4);
     let fixed = SolverParams { max_internal_step: dt, ..s.clone() };
-    (Simulator::new(p, &fixed, &Tunables::physical(s.n_modes)).unwrap(), dt)
+    (Simulator::new(p.build().unwrap(), &fixed, &Loads::physical(s.n_modes)).unwrap(), dt)
 }
 
 fn internal_step(c: &mut Criterion) {
-    for name in SCENE_NAMES {
-        let p = SceneParams::canonical(name).unwrap();
-        let n = scene::Scene::build(&p).unwrap().n_dofs();
+    for name in scenes::names() {
+        let p = scenes::canonical(name).unwrap().grid;
+        let n = p.build().unwrap().n_dofs();
         let mut group = c.benchmark_group(format!("internal_step/{name}"));
         for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit] {
-            let mut configs: Vec<(String, SolverParams)> = [2usize, 8, 32]
-                .into_iter()
-                .filter(|&r| r <= n)
-                .map(|r| (format!("modal-r{r}"), SolverParams { n_modes: r, integrator, ..SolverParams::default() }))
-                .collect();
-            configs.push(("full".into(), SolverParams { reduction: Reduction::Full, n_modes: 0, integrator, ..SolverParams::default() }));
+            let mut configs: Vec<(String, SolverParams)> =
+                [2usize, 8, 32].into_iter().filter(|&r| r <= n).map(|r| (format!("modal-r{r}"), SolverParams::new(Reduction::Modal, integrator, r))).collect();
+            configs.push(("full".into(), SolverParams::new(Reduction::Full, integrator, 0)));
             for (label, s) in configs {
                 let (mut sim, dt) = simulator(&p, &s);
                 let h = dt * PER_CALL as f64 * (1.0 - 1e-9);
@@ -63,8 +61,8 @@ unsafe extern "C" fn silent(_: fmi3InstanceEnvironment, _: fmi3Status, _: fmi3St
 
 fn do_step(c: &mut Criterion) {
     let name = "paper-2d-top-row";
-    let p = SceneParams::canonical(name).unwrap();
-    let s = SolverParams::default();
+    let p = scenes::canonical(name).unwrap().grid;
+    let s = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 2);
     let (mut many, dt) = simulator(&p, &s);
     let (mut one, _) = simulator(&p, &s);
     let mut group = c.benchmark_group(format!("do_step/{name}"));

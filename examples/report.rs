@@ -10,6 +10,7 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use modal_mass_spring::physics::*;
+use modal_mass_spring::scenes;
 
 /// Output times are multiples of this; every co-simulation step divides it.
 const FRAME: f64 = 0.05;
@@ -22,7 +23,7 @@ const STEPS: [(f64, &str); 3] = [(1.0 / 1000.0, "1/1000"), (1.0 / 240.0, "1/240"
 
 struct SceneCase {
     label: String,
-    params: SceneParams,
+    params: Grid,
 }
 
 struct Row {
@@ -54,22 +55,15 @@ struct Trajectory {
     internal_steps: usize,
 }
 
-fn integrator_name(i: Integrator) -> &'static str {
-    match i {
-        Integrator::NewmarkExplicit => "newmark-explicit",
-        Integrator::NewmarkImplicit => "newmark-implicit",
-    }
-}
-
 /// Implicit modal runs whose reduced tangent is costlier than this are not run.
 const IMPLICIT_TANGENT_LIMIT: f64 = 5e7;
 
 /// Runs over budget stop here; the report lists them as such (not as unstable).
 const OVER_BUDGET: &str = "over the time budget";
 
-fn simulate(p: &SceneParams, s: &SolverParams, h: f64, seconds: f64, budget_s: f64) -> Result<Trajectory, SimError> {
+fn simulate(p: &Grid, s: &SolverParams, h: f64, seconds: f64, budget_s: f64) -> Result<Trajectory, String> {
     let t0 = Instant::now();
-    let mut sim = Simulator::new(p, s, &Tunables::physical(s.n_modes))?;
+    let mut sim = p.build().and_then(|scene| Simulator::new(scene, s, &Loads::physical(s.n_modes))).map_err(|e| e.to_string())?;
     let setup_s = t0.elapsed().as_secs_f64();
     let per_frame = (FRAME / h).round() as usize;
     let n_frames = (seconds / FRAME).round() as usize;
@@ -79,10 +73,10 @@ fn simulate(p: &SceneParams, s: &SolverParams, h: f64, seconds: f64, budget_s: f
     let t1 = Instant::now();
     for _ in 0..n_frames {
         for _ in 0..per_frame {
-            sim.do_step(h)?;
+            sim.do_step(h).map_err(|e| e.to_string())?;
             internal_steps += sim.internal_steps_last();
             if t1.elapsed().as_secs_f64() > budget_s {
-                return Err(SimError { message: format!("{OVER_BUDGET}: stopped after {budget_s} s of wall time at t = {:.3} s", sim.time()) });
+                return Err(format!("{OVER_BUDGET}: stopped after {budget_s} s of wall time at t = {:.3} s", sim.time()));
             }
         }
         frames.push(sim.positions().to_vec());
@@ -141,10 +135,10 @@ fn main() {
     // Wall time one run may take before it is stopped and listed as over budget.
     let budget_s = if quick { 5.0 } else { 10.0 };
     let cases: Vec<SceneCase> = if quick {
-        ["paper-2d-top-row", "paper-3d-sheet"].into_iter().map(|n| SceneCase { label: n.into(), params: SceneParams::canonical(n).unwrap() }).collect()
+        ["paper-2d-top-row", "paper-3d-sheet"].into_iter().map(|n| SceneCase { label: n.into(), params: scenes::canonical(n).unwrap().grid }).collect()
     } else {
-        let mut c: Vec<SceneCase> = SCENE_NAMES.iter().map(|n| SceneCase { label: (*n).into(), params: SceneParams::canonical(n).unwrap() }).collect();
-        c.push(SceneCase { label: "cloth-3d-100x100".into(), params: SceneParams::grid(100, 100, 3, FixedNodes::TopRow) });
+        let mut c: Vec<SceneCase> = scenes::names().into_iter().map(|n| SceneCase { label: n.into(), params: scenes::canonical(n).unwrap().grid }).collect();
+        c.push(SceneCase { label: "cloth-3d-100x100".into(), params: scenes::cloth(100, 100).grid });
         c
     };
     std::fs::create_dir_all(&out).expect("cannot create the output folder");
@@ -153,7 +147,7 @@ fn main() {
     let mut plans: Vec<(usize, Vec<Plan>)> = Vec::new();
     for (ci, case) in cases.iter().enumerate() {
         let p = &case.params;
-        let n = scene::Scene::build(p).unwrap().n_dofs();
+        let n = p.build().unwrap().n_dofs();
         let full = |integrator, max_internal_step| SolverParams { reduction: Reduction::Full, integrator, n_modes: 0, max_internal_step, substepping: true };
         let mut mode_counts: Vec<usize> = std::iter::successors(Some(1usize), |r| Some(r * 2)).take_while(|&r| r < n).collect();
         // Beyond a quarter of the DOFs the basis needs the dense eigensolver;
@@ -163,7 +157,7 @@ fn main() {
         if n <= modes::MAX_DENSE_DOFS {
             mode_counts.push(n);
         }
-        let springs = scene::Scene::build(p).unwrap().springs.len();
+        let springs = p.build().unwrap().springs.len();
         if quick {
             mode_counts.retain(|&r| r <= 8 || r == n);
         }
@@ -190,7 +184,7 @@ fn main() {
             }
         }
         // Full space, explicit, at internal steps below its largest stable one.
-        let stable_dt = Simulator::new(p, &full(Integrator::NewmarkExplicit, 1.0), &Tunables::physical(0)).unwrap().max_stable_step();
+        let stable_dt = Simulator::new(p.build().unwrap(), &full(Integrator::NewmarkExplicit, 1.0), &Loads::physical(0)).unwrap().max_stable_step();
         for frac in [0.5, 0.25] {
             list.push(Plan {
                 solver: full(Integrator::NewmarkExplicit, stable_dt * frac),
@@ -210,7 +204,7 @@ fn main() {
     for (ci, list) in plans {
         let case = &cases[ci];
         let p = &case.params;
-        let n = scene::Scene::build(p).unwrap().n_dofs();
+        let n = p.build().unwrap().n_dofs();
         let full = |integrator, max_internal_step| SolverParams { reduction: Reduction::Full, integrator, n_modes: 0, max_internal_step, substepping: true };
         bar.set_message(format!("{}: reference", case.label));
         let reference = simulate(p, &full(Integrator::NewmarkExplicit, reference_dt), reference_dt, seconds, f64::INFINITY).expect("reference run failed");
@@ -233,11 +227,11 @@ fn main() {
         for plan in list {
             let s = &plan.solver;
             let method = if s.reduction == Reduction::Modal { "modal" } else { "full" };
-            bar.set_message(format!("{}: {method} {} r={} step {}", case.label, integrator_name(s.integrator), s.n_modes, plan.step_label));
+            bar.set_message(format!("{}: {method} {} r={} step {}", case.label, s.integrator.name(), s.n_modes, plan.step_label));
             let mut times = Vec::new();
             let mut last = None;
             if plan.note.starts_with("not run") {
-                last = Some(Err(SimError { message: plan.note.clone() }));
+                last = Some(Err(plan.note.clone()));
             }
             for k in 0..if last.is_some() { 0 } else { repeats } {
                 match simulate(p, s, plan.step, seconds, budget_s) {
@@ -261,7 +255,7 @@ fn main() {
                 scene: case.label.clone(),
                 dofs: n,
                 method,
-                integrator: integrator_name(s.integrator),
+                integrator: s.integrator.name(),
                 modes: if s.reduction == Reduction::Modal { s.n_modes } else { n },
                 step: plan.step,
                 step_label: plan.step_label.clone(),
@@ -284,7 +278,7 @@ fn main() {
                     row.setup_s = t.setup_s;
                     row.run_s_per_sim_s = median(times);
                     row.error = e;
-                    row.max_node_error = max_node_error(&t.frames, &reference.frames, p.dimension);
+                    row.max_node_error = max_node_error(&t.frames, &reference.frames, p.dim);
                     run_by_window.push(by_window);
                     row.stable = e.is_finite();
                     if method == "full" && plan.note.is_empty() {
@@ -294,7 +288,7 @@ fn main() {
                     }
                 }
                 Err(e) => {
-                    row.note = e.message.replace(',', ";");
+                    row.note = e.replace(',', ";");
                     run_by_window.push(Vec::new());
                 }
             }

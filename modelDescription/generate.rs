@@ -92,6 +92,10 @@ pub struct Variable {
     pub description: String,
     #[serde(default)]
     pub dimensions: Vec<toml::Value>,
+    /// Outputs: the inputs this output depends on directly at a
+    /// communication point (ModelStructure `dependencies`); absent: every input.
+    #[serde(default)]
+    pub depends_on: Option<Vec<String>>,
 }
 
 /// One array dimension: a fixed size or the value of a structural parameter.
@@ -121,6 +125,11 @@ impl Variable {
     pub fn has_start(&self) -> bool {
         self.start.is_some()
     }
+
+    /// Parameters and inputs: the variables the importer sets.
+    pub fn holds_value(&self) -> bool {
+        matches!(self.causality.as_str(), "parameter" | "structuralParameter" | "input")
+    }
 }
 
 fn numbers(v: &toml::Value) -> Vec<f64> {
@@ -145,7 +154,7 @@ pub fn parse(text: &str) -> Result<Spec, String> {
 }
 
 const TYPES: [&str; 4] = ["Float64", "UInt64", "Boolean", "Enumeration"];
-const CAUSALITIES: [&str; 5] = ["independent", "structuralParameter", "parameter", "calculatedParameter", "output"];
+const CAUSALITIES: [&str; 6] = ["independent", "structuralParameter", "parameter", "calculatedParameter", "input", "output"];
 
 impl Spec {
     fn check(&self) -> Result<(), String> {
@@ -195,9 +204,21 @@ impl Spec {
                     return Err(format!("{}: unit {u} is not defined", v.name));
                 }
             }
-            let parameter = matches!(v.causality.as_str(), "parameter" | "structuralParameter");
-            if parameter != v.has_start() {
-                return Err(format!("{}: parameters and only parameters have a start value", v.name));
+            if v.holds_value() != v.has_start() {
+                return Err(format!("{}: parameters and inputs, and only they, have a start value", v.name));
+            }
+            if v.causality == "input" && v.variability != "continuous" && v.variability != "discrete" {
+                return Err(format!("{}: an input is continuous or discrete", v.name));
+            }
+            if let Some(deps) = &v.depends_on {
+                if v.causality != "output" {
+                    return Err(format!("{}: only outputs have depends_on", v.name));
+                }
+                for d in deps {
+                    if self.variable(d).is_none_or(|x| x.causality != "input") {
+                        return Err(format!("{}: depends_on names {d}, which is not an input", v.name));
+                    }
+                }
             }
             for d in v.dims() {
                 if let Dim::Param(p) = d {
@@ -366,15 +387,29 @@ impl Spec {
         let mut outputs: Vec<&Variable> = self.variables.iter().filter(|v| v.causality == "output").collect();
         outputs.sort_by_key(|v| v.vr);
         for v in &outputs {
-            let _ = writeln!(w, "    <Output valueReference=\"{}\"/>", v.vr);
+            let _ = writeln!(w, "    <Output valueReference=\"{}\"{}/>", v.vr, self.dependencies(v));
         }
         let mut initial: Vec<&Variable> = self.variables.iter().filter(|v| v.causality == "output" || v.causality == "calculatedParameter").collect();
         initial.sort_by_key(|v| v.vr);
         for v in &initial {
-            let _ = writeln!(w, "    <InitialUnknown valueReference=\"{}\"/>", v.vr);
+            let _ = writeln!(w, "    <InitialUnknown valueReference=\"{}\"{}/>", v.vr, self.dependencies(v));
         }
         w.push_str("  </ModelStructure>\n</fmiModelDescription>\n");
         Ok(x)
+    }
+
+    /// The `dependencies` attribute of an output in ModelStructure: the
+    /// inputs it declares in `depends_on` (none: it depends on the inputs
+    /// only through the state, so chained FMUs form no algebraic loop). No
+    /// attribute (every known) where the table declares nothing or has no input.
+    fn dependencies(&self, v: &Variable) -> String {
+        match &v.depends_on {
+            Some(deps) if self.variables.iter().any(|x| x.causality == "input") => {
+                let vrs: Vec<String> = deps.iter().map(|d| self.variable(d).unwrap().vr.to_string()).collect();
+                format!(" dependencies=\"{}\"", vrs.join(" "))
+            }
+            _ => String::new(),
+        }
     }
 
     /// `resources/startValues.txt`: one line per parameter, `name value...`,
@@ -493,7 +528,54 @@ impl Spec {
                 enum_values.join(", ")
             );
         }
+        r.push_str("];\n\n/// The canonical scenes: start values that differ from the defaults.\npub static SCENES: &[CanonicalScene] = &[\n");
+        for name in self.scene_names() {
+            let values: Vec<String> = self
+                .scene(&name)
+                .unwrap()
+                .iter()
+                .map(|(var, x)| {
+                    let numbers: Vec<String> = x.iter().map(|v| format!("{v:?}")).collect();
+                    format!("({}, &[{}])", self.variable(var).unwrap().vr, numbers.join(", "))
+                })
+                .collect();
+            let _ = writeln!(r, "    CanonicalScene {{ name: {name:?}, values: &[{}] }},", values.join(", "));
+        }
         r.push_str("];\n");
+        r
+    }
+
+    /// Rust source of the option enumerations (one Rust enum per
+    /// `[[enumerations]]` table, one variant per item, named in CamelCase
+    /// from the item's name); `include!`d by `src/options.rs`.
+    pub fn options_source(&self) -> String {
+        let mut r = String::new();
+        let _ = writeln!(r, "// Generated by modelDescription/generate.rs from variables.toml. Do not edit.");
+        for e in &self.enumerations {
+            let name = &e.name;
+            let variants: Vec<String> = e.items.iter().map(|i| variant(&i.name)).collect();
+            let _ = writeln!(r, "\n/// {}\n#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]\npub enum {name} {{", e.description);
+            for (i, v) in e.items.iter().zip(&variants) {
+                let _ = writeln!(r, "    /// `{}` ({}): {}\n    {v} = {},", i.name, i.value, i.description, i.value);
+            }
+            let _ = writeln!(r, "}}\n\nimpl {name} {{");
+            let all: Vec<String> = variants.iter().map(|v| format!("{name}::{v}")).collect();
+            let _ = writeln!(r, "    /// Every item, in the order of the variable table.\n    pub const ALL: &'static [{name}] = &[{}];", all.join(", "));
+            let _ = writeln!(
+                r,
+                "    /// The item with this value in the model description.\n    pub fn from_value(value: i64) -> Option<Self> {{\n        match value {{"
+            );
+            for (i, v) in e.items.iter().zip(&variants) {
+                let _ = writeln!(r, "            {} => Some({name}::{v}),", i.value);
+            }
+            let _ = writeln!(r, "            _ => None,\n        }}\n    }}");
+            let _ = writeln!(r, "    /// The value of the item in the model description.\n    pub fn value(self) -> i64 {{\n        self as i64\n    }}");
+            let _ = writeln!(r, "    /// The name of the item in the model description.\n    pub fn name(self) -> &'static str {{\n        match self {{");
+            for (i, v) in e.items.iter().zip(&variants) {
+                let _ = writeln!(r, "            {name}::{v} => {:?},", i.name);
+            }
+            let _ = writeln!(r, "        }}\n    }}\n}}");
+        }
         r
     }
 
@@ -542,6 +624,11 @@ fn camel(s: &str) -> String {
         Some(f) => f.to_ascii_uppercase().to_string() + c.as_str(),
         None => String::new(),
     }
+}
+
+/// `newmark-explicit` -> `NewmarkExplicit`.
+fn variant(item: &str) -> String {
+    item.split(['-', '_', ' ']).map(camel).collect()
 }
 
 fn screaming(s: &str) -> String {

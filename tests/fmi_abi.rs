@@ -465,7 +465,7 @@ fn n_values_is_checked_before_the_array_is_used() {
 fn ranges_are_enforced_by_the_setters() {
     use modal_mass_spring::fmi::variables::{Type, VARIABLES};
     let f = Fmu::new();
-    for v in VARIABLES.iter().filter(|v| v.is_parameter()) {
+    for v in VARIABLES.iter().filter(|v| v.holds_value()) {
         let n = match v.vr {
             vr::GRAVITY => 3,
             vr::MODE_WEIGHTS => 2,
@@ -627,7 +627,7 @@ fn every_corruption_of_a_serialized_state_is_refused() {
     assert_eq!(seal(&p), blob);
     p[0] = 9;
     refused_unchanged(&f, &seal(&p), "mode 9");
-    let edit = |change: &dyn Fn(&mut modal_mass_spring::fmi::instance::FmuState)| {
+    let edit = |change: &dyn Fn(&mut modal_mass_spring::fmi::fmu_state::FmuState)| {
         let mut s = good.clone();
         change(&mut s);
         seal(&payload(&s))
@@ -642,17 +642,24 @@ fn every_corruption_of_a_serialized_state_is_refused() {
     refused_unchanged(&f, &edit(&|s| s.params.values[idx(vr::MODE_WEIGHTS)].pop().map(|_| ()).unwrap()), "one weight for two modes");
     refused_unchanged(&f, &edit(&|s| s.params.values[idx(vr::NX)][0] = 11.0), "another grid");
     refused_unchanged(&f, &edit(&|s| s.snapshot = None), "Step Mode without simulator state");
-    refused_unchanged(&f, &edit(&|s| s.snapshot.as_mut().unwrap().state[0] = f64::NAN), "NaN in the simulator state");
-    refused_unchanged(&f, &edit(&|s| s.snapshot.as_mut().unwrap().time = -1.0), "negative simulator time");
-    refused_unchanged(&f, &edit(&|s| s.snapshot.as_mut().unwrap().tunables.damping_alpha = 3.0), "tunables that differ");
+    refused_unchanged(&f, &edit(&|s| s.snapshot.as_mut().unwrap().state.y[0] = f64::NAN), "NaN in the simulator state");
+    refused_unchanged(&f, &edit(&|s| s.snapshot.as_mut().unwrap().state.time = -1.0), "negative simulator time");
+    refused_unchanged(&f, &edit(&|s| s.snapshot.as_mut().unwrap().loads.damping_alpha = 3.0), "loads that differ from the parameters");
+    refused_unchanged(&f, &edit(&|s| s.snapshot.as_mut().unwrap().state.v.push(0.0)), "velocities longer than the coordinates");
     let mut extra = payload(&good);
     extra.push(0);
     refused_unchanged(&f, &seal(&extra), "a byte after the payload");
 
     // Decodable, but refused when made current: the instance stays as it was.
     for (what, bad) in [
-        ("a simulator state of the wrong length", edit(&|s| s.snapshot.as_mut().unwrap().state.push(0.0))),
-        ("positions that overflow the energies", edit(&|s| s.snapshot.as_mut().unwrap().state[0] = 1e300)),
+        (
+            "a simulator state of the wrong length",
+            edit(&|s| {
+                let st = &mut s.snapshot.as_mut().unwrap().state;
+                [&mut st.y, &mut st.v, &mut st.a].into_iter().for_each(|x| x.push(0.0));
+            }),
+        ),
+        ("positions that overflow the energies", edit(&|s| s.snapshot.as_mut().unwrap().state.y[0] = 1e300)),
     ] {
         let (state, outputs) = (f.snapshot(), f.outputs());
         let (s, p) = f.deserialize(&bad);

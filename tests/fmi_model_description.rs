@@ -1,7 +1,7 @@
 //! The model description generated from modelDescription/variables.toml:
 //! parsed back with fmi-schema, checked with fmi-rs (the checks of
 //! `fmusim validate`), compared with the variable table compiled into the
-//! binary, and the scene start values compared with SceneParams::canonical.
+//! binary, and the canonical scenes compared with those of docs/method.md.
 
 #[path = "../modelDescription/generate.rs"]
 mod generate;
@@ -9,8 +9,9 @@ mod generate;
 use std::collections::BTreeMap;
 
 use fmi_schema::fmi3::Fmi3ModelDescription;
+use modal_mass_spring::fmi::model::Params;
 use modal_mass_spring::fmi::variables::{self, Type, VARIABLES};
-use modal_mass_spring::physics::{FixedNodes, SceneParams, SCENE_NAMES};
+use modal_mass_spring::options::{FixedNodes, Integrator};
 
 fn spec() -> generate::Spec {
     generate::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("modelDescription/variables.toml")).unwrap()
@@ -20,7 +21,7 @@ fn spec() -> generate::Spec {
 fn descriptions() -> Vec<(String, String)> {
     let spec = spec();
     let mut out = vec![("default".to_string(), spec.model_description_xml(&BTreeMap::new()).unwrap())];
-    for name in SCENE_NAMES {
+    for name in variables::scene_names() {
         let o = spec.scene(name).unwrap_or_else(|| panic!("scene {name} missing from variables.toml"));
         out.push((name.to_string(), spec.model_description_xml(&o).unwrap()));
     }
@@ -87,45 +88,111 @@ fn validation_catches_a_broken_description() {
     assert!(!md.validate().is_empty());
 }
 
-fn scene_from_starts(s: &BTreeMap<String, Vec<f64>>) -> SceneParams {
-    let x = |n: &str| s[n][0];
-    SceneParams {
-        nx: x("nx") as usize,
-        ny: x("ny") as usize,
-        dimension: x("dimension") as usize,
-        spacing: x("spacing"),
-        node_mass: x("nodeMass"),
-        spring_stiffness: x("springStiffness"),
-        shear_springs: x("shearSprings") != 0.0,
-        bending_springs: x("bendingSprings") != 0.0,
-        aux_stiffness: x("auxStiffness"),
-        fixed_nodes: if x("fixedNodes") == 2.0 { FixedNodes::TopCorners } else { FixedNodes::TopRow },
-    }
-}
+/// The canonical scenes of `docs/method.md`, section 5: (name, nx, ny, dimension, fixedNodes, auxStiffness).
+const METHOD_SCENES: [(&str, usize, usize, usize, FixedNodes, f64); 4] = [
+    ("paper-2d-top-row", 10, 10, 2, FixedNodes::TopRow, 0.0),
+    ("paper-2d-top-corners", 10, 10, 2, FixedNodes::TopCorners, 0.0),
+    ("paper-3d-sheet", 7, 7, 3, FixedNodes::TopRow, 0.05),
+    ("cloth-3d", 30, 30, 3, FixedNodes::TopRow, 0.05),
+];
 
 #[test]
 fn scene_start_values_are_the_canonical_scenes() {
     let spec = spec();
-    assert_eq!(spec.scene_names().len(), SCENE_NAMES.len());
-    for name in SCENE_NAMES {
+    assert_eq!(spec.scene_names(), variables::scene_names().collect::<Vec<_>>());
+    assert_eq!(variables::SCENES.len(), METHOD_SCENES.len());
+    for (name, nx, ny, dim, fixed, aux) in METHOD_SCENES {
+        let p = Params::canonical(name).unwrap_or_else(|| panic!("{name} is not a canonical scene"));
+        let g = p.grid();
+        assert_eq!((g.columns, g.rows, g.dim, g.fixed_nodes, g.aux_stiffness), (nx, ny, dim, fixed, aux), "{name}");
+        // The defaults of docs/method.md, section 5.
+        assert_eq!((g.spacing, g.node_mass, g.spring_stiffness, g.shear_springs, g.bending_springs), (0.1, 0.01, 50.0, true, false), "{name}");
+        // The binary's scene and the XML generator's start values agree.
         let starts = spec.starts(&spec.scene(name).unwrap()).unwrap();
-        assert_eq!(scene_from_starts(&starts), SceneParams::canonical(name).unwrap(), "{name}");
-        let n_modes = starts["nModes"][0] as usize;
-        assert_eq!(starts["modeWeights"].len(), n_modes, "{name}: modeWeights fitted to nModes");
+        for v in VARIABLES.iter().filter(|v| v.holds_value()) {
+            assert_eq!(starts[v.name], p.get(v.vr), "{name}: {}", v.name);
+        }
+        assert_eq!(p.get(variables::vr::MODE_WEIGHTS).len(), p.scalar(variables::vr::N_MODES) as usize, "{name}: modeWeights fitted to nModes");
     }
 }
 
 #[test]
 fn defaults_are_paper_2d_top_row() {
-    let spec = spec();
-    let starts = spec.starts(&BTreeMap::new()).unwrap();
-    let mut default = SceneParams::canonical("paper-2d-top-row").unwrap();
+    let mut default = Params::start().grid();
     // auxStiffness acts in 3D only; its default is the 3D default k / 1000.
-    default.aux_stiffness = 0.05;
-    assert_eq!(scene_from_starts(&starts), default);
-    assert_eq!(starts["nModes"], vec![2.0]);
-    assert_eq!(starts["integrator"], vec![1.0]);
-    assert_eq!(starts["dampingAlpha"], vec![0.0]);
+    assert_eq!(default.aux_stiffness, 0.05);
+    default.aux_stiffness = 0.0;
+    assert_eq!(default, Params::canonical("paper-2d-top-row").unwrap().grid());
+    let p = Params::start();
+    assert_eq!(p.get(variables::vr::N_MODES), [2.0]);
+    assert_eq!(p.solver().integrator, Integrator::NewmarkExplicit);
+    assert_eq!(p.loads().damping_alpha, 0.0);
+}
+
+/// A variable table with an input: the generator writes it as FMI 3.0 wants
+/// (causality, start value, the outputs' dependencies) and the Rust table marks it.
+const WITH_INPUT: &str = r#"
+[[variables]]
+name = "push"
+vr = 40
+type = "Float64"
+causality = "input"
+variability = "continuous"
+start = 0.0
+unit = "m"
+description = "A test input"
+
+[[variables]]
+name = "reading"
+vr = 41
+type = "Float64"
+causality = "output"
+variability = "continuous"
+depends_on = []
+description = "An output that depends on no input directly"
+
+[[variables]]
+name = "echo"
+vr = 42
+type = "Float64"
+causality = "output"
+variability = "continuous"
+depends_on = ["push"]
+description = "An output that depends on the input directly"
+"#;
+
+fn spec_with_input() -> Result<generate::Spec, String> {
+    let text = std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("modelDescription/variables.toml")).unwrap();
+    let (head, scenes) = text.split_once("\n[scenes.").unwrap();
+    generate::parse(&format!("{head}\n{WITH_INPUT}\n[scenes.{scenes}"))
+}
+
+#[test]
+fn inputs_are_generated_end_to_end() {
+    let spec = spec_with_input().unwrap();
+    let xml = spec.model_description_xml(&BTreeMap::new()).unwrap();
+    assert!(xml.contains(r#"name="push" valueReference="40" description="A test input" causality="input" variability="continuous""#), "{xml}");
+    assert!(attribute(&xml, "push", "start") == Some(0.0));
+    assert!(xml.contains(r#"<Output valueReference="41" dependencies=""/>"#), "{xml}");
+    assert!(xml.contains(r#"<Output valueReference="42" dependencies="40"/>"#), "{xml}");
+    // Outputs that declare nothing depend on every input.
+    assert!(xml.contains(r#"<Output valueReference="30"/>"#), "{xml}");
+    let md = fmi_rs::model_description::fmi3::ModelDescription::from_string(&xml).unwrap();
+    let problems: Vec<String> = md.validate().into_iter().map(|p| p.message).collect();
+    assert!(problems.is_empty(), "{problems:#?}");
+    #[cfg(feature = "xsd")]
+    {
+        let problems = fmi_rs::schema::validate_fmi3_model_description(xml.as_bytes());
+        assert!(problems.is_empty(), "{problems:#?}");
+    }
+    let rust = spec.rust_source();
+    assert!(rust.contains(r#"name: "push", vr: 40, ty: Type::Float64, causality: Causality::Input"#), "{rust}");
+    // An input is set by the host, so it has a start value and a place in startValues.txt.
+    assert!(spec.start_values_text(&BTreeMap::new()).unwrap().contains("\npush 0.0\n"));
+    let broken = WITH_INPUT.replacen("start = 0.0\n", "", 1);
+    let text = std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("modelDescription/variables.toml")).unwrap();
+    let (head, _) = text.split_once("\n[scenes.").unwrap();
+    assert!(generate::parse(&format!("{head}\n{broken}")).unwrap_err().contains("push: parameters and inputs"));
 }
 
 #[test]
@@ -231,7 +298,7 @@ fn ranges_of_the_xml_are_those_the_binary_enforces() {
         assert_eq!(attribute(&xml, v.name, "max"), v.max, "{}: max", v.name);
     }
     // Every numeric parameter is bounded on both sides; array sizes from 1 up.
-    for v in VARIABLES.iter().filter(|v| v.is_parameter() && matches!(v.ty, Type::Float64 | Type::UInt64)) {
+    for v in VARIABLES.iter().filter(|v| v.holds_value() && matches!(v.ty, Type::Float64 | Type::UInt64)) {
         let (lo, hi) = (v.min.unwrap_or_else(|| panic!("{}: no min", v.name)), v.max.unwrap_or_else(|| panic!("{}: no max", v.name)));
         assert!(lo.is_finite() && hi.is_finite() && lo < hi, "{}", v.name);
         if v.causality == variables::Causality::StructuralParameter {

@@ -21,7 +21,7 @@ use std::ptr::{null, null_mut};
 use common::*;
 use fmi_sys::fmi3::*;
 use modal_mass_spring::fmi::exports::*;
-use modal_mass_spring::fmi::instance::Mode;
+use modal_mass_spring::fmi::state_machine::Mode;
 use modal_mass_spring::fmi::variables::{vr, Causality, Type, Variability, VARIABLES};
 
 /// The states a test instance is driven into; `Reset` is Instantiated reached through fmi3Reset.

@@ -5,6 +5,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use modal_mass_spring::physics::*;
+use modal_mass_spring::scenes;
 
 struct Counting;
 static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
@@ -31,11 +32,9 @@ fn do_step_allocates_nothing() {
     for name in ["paper-2d-top-row", "paper-3d-sheet"] {
         for reduction in [Reduction::Modal, Reduction::Full] {
             for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit] {
-                let p = SceneParams::canonical(name).unwrap();
-                let s = SolverParams { reduction, integrator, n_modes: 4, ..SolverParams::default() };
-                let mut t = Tunables::physical(4);
-                t.damping_beta = 1e-3; // exercises the factorised explicit velocity update too
-                let mut sim = Simulator::new(&p, &s, &t).unwrap();
+                let mut setup = scenes::canonical(name).unwrap().with_solver(SolverParams::new(reduction, integrator, 4));
+                setup.loads.damping_beta = 1e-3; // exercises the factorised explicit velocity update too
+                let mut sim = setup.simulator().unwrap();
                 sim.do_step(0.01).unwrap(); // first step may factorise
                 let before = ALLOCATIONS.load(Ordering::SeqCst);
                 for _ in 0..20 {

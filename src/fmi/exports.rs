@@ -1,74 +1,57 @@
-//! The `fmi3*` C ABI. One guard per function: a null or foreign instance is
-//! refused, the FMI state is checked, and a panic is caught and reported
-//! instead of unwinding into the importer. Every signature is checked at
-//! compile time against the `fmi3...TYPE` aliases of the official headers.
+//! The `fmi3*` C ABI: one short entry per function of the FMI 3.0 API.
+//!
+//! Each entry names its row of [`super::functions`]'s table and hands the
+//! call to [`call`], which refuses a null, freed or foreign instance, checks
+//! the state against the table (the one guard, [`Instance::guard`]), catches
+//! any panic instead of unwinding into the importer, and runs the body on
+//! the instance. Functions this FMU does not provide are refused with the
+//! table's reason ([`refuse`]). Every signature is checked at compile time
+//! against the `fmi3...TYPE` alias of the official headers (the `const _`
+//! after it), and cbindgen writes the C header from this file.
 
-#![allow(non_snake_case, clippy::missing_safety_doc, clippy::too_many_arguments)]
+#![allow(clippy::missing_safety_doc, clippy::too_many_arguments)]
 
-use std::ffi::{c_char, CStr};
+use std::ffi::c_char;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use fmi_sys::fmi3::*;
 
-use super::instance::{log_raw, mask, slice, too_many, Instance, ERROR, FATAL, OK};
-use super::model::Params;
-use super::serialize;
-use super::variables::{index_of, Type, INSTANTIATION_TOKEN, VARIABLES};
+use super::functions::Function as F;
+use super::instance::Instance;
+use super::variables::Type;
+use super::{instantiate, registry, ERROR, FATAL};
 
 fn panic_message(p: &Box<dyn std::any::Any + Send>) -> String {
     p.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| p.downcast_ref::<String>().cloned()).unwrap_or_else(|| "unknown panic".into())
 }
 
-/// Runs `body` on a valid instance; a panic poisons the instance and returns fmi3Fatal.
-fn call(instance: fmi3Instance, f: &str, body: impl FnOnce(&mut Instance) -> Result<fmi3Status, fmi3Status>) -> fmi3Status {
-    let Some(inst) = (unsafe { Instance::from_ptr(instance) }) else {
+/// Runs `body` on a live instance in a state where `f` is legal; a panic
+/// poisons the instance and returns fmi3Fatal.
+fn call(instance: fmi3Instance, f: F, body: impl FnOnce(&mut Instance) -> Result<fmi3Status, fmi3Status>) -> fmi3Status {
+    let Some(inst) = (unsafe { registry::get(instance) }) else {
         return ERROR;
     };
     if inst.poisoned {
-        return inst.fail(&format!("{f}: the instance failed irrecoverably before; only fmi3FreeInstance is possible"));
+        return inst.log.fail(&format!("{}: the instance failed irrecoverably before; only fmi3FreeInstance is possible", f.name()));
     }
-    match catch_unwind(AssertUnwindSafe(|| body(inst))) {
+    match catch_unwind(AssertUnwindSafe(|| inst.guard(f).and_then(|()| body(inst)))) {
         Ok(Ok(s)) | Ok(Err(s)) => s,
         Err(p) => {
             let msg = panic_message(&p);
             // The borrow given to `body` ended with the unwind.
-            if let Some(inst) = unsafe { Instance::from_ptr(instance) } {
+            if let Some(inst) = unsafe { registry::get(instance) } {
                 inst.poisoned = true;
-                inst.log(FATAL, &format!("{f}: internal error: {msg}"));
+                inst.log.log(FATAL, &format!("{}: internal error: {msg}", f.name()));
             }
             FATAL
         }
     }
 }
 
-fn unsupported(instance: fmi3Instance, f: &str, reason: &str) -> fmi3Status {
-    call(instance, f, |inst| Err(inst.fail(&format!("{f}: {reason}"))))
+/// A function this FMU does not provide: refused with the table's reason.
+fn refuse(instance: fmi3Instance, f: F) -> fmi3Status {
+    call(instance, f, |_| unreachable!("{} is legal in no state", f.name()))
 }
-
-const NO_ME: &str = "this FMU supports Co-Simulation only, not Model Exchange";
-const NO_SE: &str = "this FMU supports Co-Simulation only, not Scheduled Execution";
-const NO_CLOCKS: &str = "this FMU has no clocks";
-const NO_EVENTS: &str = "this FMU has no Event Mode (hasEventMode = false)";
-
-/// Get/Set of a type no variable of this FMU has: only an empty request succeeds.
-fn no_variables(inst: &mut Instance, f: &str, type_name: &str, vrs: *const fmi3ValueReference, n: usize, mask: u32) -> Result<fmi3Status, fmi3Status> {
-    inst.guard(f, mask)?;
-    if n > 0 && vrs.is_null() {
-        return Err(inst.fail(&format!("{f}: valueReferences is NULL")));
-    }
-    if too_many::<fmi3ValueReference>(n) {
-        return Err(inst.fail(&format!("{f}: nValueReferences = {n} cannot be an array size")));
-    }
-    if let Some(&r) = unsafe { slice(vrs, n) }.first() {
-        return Err(match index_of(r) {
-            Some(i) => inst.fail(&format!("{f}: {} (value reference {r}) is a {}, not a {type_name}", VARIABLES[i].name, VARIABLES[i].ty.name())),
-            None => inst.fail(&format!("{f}: unknown value reference {r}")),
-        });
-    }
-    Ok(OK)
-}
-
-// ---- Common functions --------------------------------------------------------
 
 #[no_mangle]
 pub extern "C" fn fmi3GetVersion() -> *const c_char {
@@ -77,383 +60,239 @@ pub extern "C" fn fmi3GetVersion() -> *const c_char {
 const _: fmi3GetVersionTYPE = Some(fmi3GetVersion);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetDebugLogging(instance: fmi3Instance, loggingOn: fmi3Boolean, nCategories: usize, categories: *const fmi3String) -> fmi3Status {
-    call(instance, "fmi3SetDebugLogging", |inst| inst.set_debug_logging(loggingOn, nCategories, categories))
+pub unsafe extern "C" fn fmi3SetDebugLogging(
+    instance: fmi3Instance,
+    logging_on: fmi3Boolean,
+    n_categories: usize,
+    categories: *const fmi3String,
+) -> fmi3Status {
+    call(instance, F::SetDebugLogging, |inst| unsafe { inst.log.set(logging_on, n_categories, categories) })
 }
 const _: fmi3SetDebugLoggingTYPE = Some(fmi3SetDebugLogging);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3InstantiateModelExchange(
-    _instanceName: fmi3String,
-    _instantiationToken: fmi3String,
-    _resourcePath: fmi3String,
-    _visible: fmi3Boolean,
-    _loggingOn: fmi3Boolean,
-    instanceEnvironment: fmi3InstanceEnvironment,
-    logMessage: fmi3LogMessageCallback,
+    _a: fmi3String,
+    _b: fmi3String,
+    _c: fmi3String,
+    _d: fmi3Boolean,
+    _e: fmi3Boolean,
+    env: fmi3InstanceEnvironment,
+    logger: fmi3LogMessageCallback,
 ) -> fmi3Instance {
-    log_raw(instanceEnvironment, logMessage, ERROR, "logStatusError", &format!("fmi3InstantiateModelExchange: {NO_ME}"));
-    std::ptr::null_mut()
+    instantiate::refused(F::InstantiateModelExchange, env, logger)
 }
 const _: fmi3InstantiateModelExchangeTYPE = Some(fmi3InstantiateModelExchange);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
-    instanceName: fmi3String,
-    instantiationToken: fmi3String,
-    resourcePath: fmi3String,
-    _visible: fmi3Boolean,
-    loggingOn: fmi3Boolean,
-    eventModeUsed: fmi3Boolean,
-    _earlyReturnAllowed: fmi3Boolean,
-    _requiredIntermediateVariables: *const fmi3ValueReference,
-    nRequiredIntermediateVariables: usize,
-    instanceEnvironment: fmi3InstanceEnvironment,
-    logMessage: fmi3LogMessageCallback,
-    _intermediateUpdate: fmi3IntermediateUpdateCallback,
+    name: fmi3String,
+    token: fmi3String,
+    resources: fmi3String,
+    _a: fmi3Boolean,
+    logging_on: fmi3Boolean,
+    event_mode: fmi3Boolean,
+    _b: fmi3Boolean,
+    _c: *const fmi3ValueReference,
+    n_required: usize,
+    env: fmi3InstanceEnvironment,
+    logger: fmi3LogMessageCallback,
+    _d: fmi3IntermediateUpdateCallback,
 ) -> fmi3Instance {
-    let result = catch_unwind(|| {
-        let fail = |m: String| {
-            log_raw(instanceEnvironment, logMessage, ERROR, "logStatusError", &format!("fmi3InstantiateCoSimulation: {m}"));
-            std::ptr::null_mut()
-        };
-        if instantiationToken.is_null() {
-            return fail("instantiationToken is NULL".into());
-        }
-        let token = unsafe { CStr::from_ptr(instantiationToken) }.to_string_lossy();
-        if token != INSTANTIATION_TOKEN {
-            return fail(format!("instantiationToken {token} does not match this binary ({INSTANTIATION_TOKEN})"));
-        }
-        if eventModeUsed {
-            return fail(NO_EVENTS.into());
-        }
-        if nRequiredIntermediateVariables > 0 {
-            return fail("this FMU provides no intermediate update (providesIntermediateUpdate = false)".into());
-        }
-        // The standard requires a non-empty name; messages are labelled with it.
-        if instanceName.is_null() {
-            return fail("instanceName is NULL".into());
-        }
-        let name = unsafe { CStr::from_ptr(instanceName) }.to_string_lossy().into_owned();
-        if name.trim().is_empty() {
-            return fail("instanceName is empty".into());
-        }
-        let start = if resourcePath.is_null() {
-            Params::start()
-        } else {
-            let dir = unsafe { CStr::from_ptr(resourcePath) }.to_string_lossy().into_owned();
-            let dir = dir.strip_prefix("file://").unwrap_or(&dir).to_string();
-            let file = std::path::Path::new(&dir).join("startValues.txt");
-            match std::fs::read_to_string(&file) {
-                Ok(text) => match Params::from_text(&text) {
-                    Ok(p) => p,
-                    Err(m) => return fail(format!("{}: {m}", file.display())),
-                },
-                // No file: the compiled start values are those of modelDescription.xml.
-                Err(_) => Params::start(),
-            }
-        };
-        let inst = Instance::new(instanceEnvironment, logMessage, loggingOn, start);
-        inst.log(OK, &format!("instance \"{name}\" created"));
-        inst.into_raw()
-    });
-    result.unwrap_or_else(|p| {
-        log_raw(instanceEnvironment, logMessage, FATAL, "logStatusFatal", &format!("fmi3InstantiateCoSimulation: internal error: {}", panic_message(&p)));
-        std::ptr::null_mut()
-    })
+    unsafe { instantiate::co_simulation(name, token, resources, logging_on, event_mode, n_required, env, logger) }
 }
 const _: fmi3InstantiateCoSimulationTYPE = Some(fmi3InstantiateCoSimulation);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3InstantiateScheduledExecution(
-    _instanceName: fmi3String,
-    _instantiationToken: fmi3String,
-    _resourcePath: fmi3String,
-    _visible: fmi3Boolean,
-    _loggingOn: fmi3Boolean,
-    instanceEnvironment: fmi3InstanceEnvironment,
-    logMessage: fmi3LogMessageCallback,
-    _clockUpdate: fmi3ClockUpdateCallback,
-    _lockPreemption: fmi3LockPreemptionCallback,
-    _unlockPreemption: fmi3UnlockPreemptionCallback,
+    _a: fmi3String,
+    _b: fmi3String,
+    _c: fmi3String,
+    _d: fmi3Boolean,
+    _e: fmi3Boolean,
+    env: fmi3InstanceEnvironment,
+    logger: fmi3LogMessageCallback,
+    _f: fmi3ClockUpdateCallback,
+    _g: fmi3LockPreemptionCallback,
+    _h: fmi3UnlockPreemptionCallback,
 ) -> fmi3Instance {
-    log_raw(instanceEnvironment, logMessage, ERROR, "logStatusError", &format!("fmi3InstantiateScheduledExecution: {NO_SE}"));
-    std::ptr::null_mut()
+    instantiate::refused(F::InstantiateScheduledExecution, env, logger)
 }
 const _: fmi3InstantiateScheduledExecutionTYPE = Some(fmi3InstantiateScheduledExecution);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3FreeInstance(instance: fmi3Instance) {
-    let _ = catch_unwind(|| unsafe { Instance::free(instance) });
+    let _ = catch_unwind(|| unsafe { registry::free(instance) });
 }
 const _: fmi3FreeInstanceTYPE = Some(fmi3FreeInstance);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3EnterInitializationMode(
     instance: fmi3Instance,
-    _toleranceDefined: fmi3Boolean,
-    _tolerance: fmi3Float64,
-    startTime: fmi3Float64,
-    stopTimeDefined: fmi3Boolean,
-    stopTime: fmi3Float64,
+    _a: fmi3Boolean,
+    _b: fmi3Float64,
+    start: fmi3Float64,
+    stop_defined: fmi3Boolean,
+    stop: fmi3Float64,
 ) -> fmi3Status {
-    call(instance, "fmi3EnterInitializationMode", |inst| inst.enter_initialization_mode(startTime, stopTimeDefined.then_some(stopTime)))
+    call(instance, F::EnterInitializationMode, |inst| inst.enter_initialization_mode(start, stop_defined.then_some(stop)))
 }
 const _: fmi3EnterInitializationModeTYPE = Some(fmi3EnterInitializationMode);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status {
-    call(instance, "fmi3ExitInitializationMode", |inst| inst.exit_initialization_mode())
+    call(instance, F::ExitInitializationMode, |inst| inst.exit_initialization_mode())
 }
 const _: fmi3ExitInitializationModeTYPE = Some(fmi3ExitInitializationMode);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3EnterEventMode(instance: fmi3Instance) -> fmi3Status {
-    unsupported(instance, "fmi3EnterEventMode", NO_EVENTS)
+    refuse(instance, F::EnterEventMode)
 }
 const _: fmi3EnterEventModeTYPE = Some(fmi3EnterEventMode);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3Terminate(instance: fmi3Instance) -> fmi3Status {
-    call(instance, "fmi3Terminate", |inst| inst.terminate())
+    call(instance, F::Terminate, |inst| inst.terminate())
 }
 const _: fmi3TerminateTYPE = Some(fmi3Terminate);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3Reset(instance: fmi3Instance) -> fmi3Status {
-    call(instance, "fmi3Reset", |inst| inst.reset())
+    call(instance, F::Reset, |inst| inst.reset())
 }
 const _: fmi3ResetTYPE = Some(fmi3Reset);
 
-// ---- Getting and setting variable values ------------------------------------
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetFloat32(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *mut fmi3Float32,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3GetFloat32", |inst| no_variables(inst, "fmi3GetFloat32", "Float32", valueReferences, nValueReferences, mask::GET))
+pub unsafe extern "C" fn fmi3GetFloat32(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *mut fmi3Float32, _b: usize) -> fmi3Status {
+    call(instance, F::GetFloat32, |inst| unsafe { inst.no_variables(F::GetFloat32, "Float32", vrs, n_vrs) })
 }
 const _: fmi3GetFloat32TYPE = Some(fmi3GetFloat32);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetFloat32(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *const fmi3Float32,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3SetFloat32", |inst| no_variables(inst, "fmi3SetFloat32", "Float32", valueReferences, nValueReferences, mask::SET))
+pub unsafe extern "C" fn fmi3SetFloat32(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *const fmi3Float32, _b: usize) -> fmi3Status {
+    call(instance, F::SetFloat32, |inst| unsafe { inst.no_variables(F::SetFloat32, "Float32", vrs, n_vrs) })
 }
 const _: fmi3SetFloat32TYPE = Some(fmi3SetFloat32);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3GetFloat64(
     instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
+    vrs: *const fmi3ValueReference,
+    n_vrs: usize,
     values: *mut fmi3Float64,
-    nValues: usize,
+    n_values: usize,
 ) -> fmi3Status {
-    call(instance, "fmi3GetFloat64", |inst| inst.get("fmi3GetFloat64", Type::Float64, valueReferences, nValueReferences, values, nValues, |x| x))
+    call(instance, F::GetFloat64, |inst| inst.get(F::GetFloat64, Type::Float64, vrs, n_vrs, values, n_values, |x| x))
 }
 const _: fmi3GetFloat64TYPE = Some(fmi3GetFloat64);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3SetFloat64(
     instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
+    vrs: *const fmi3ValueReference,
+    n_vrs: usize,
     values: *const fmi3Float64,
-    nValues: usize,
+    n_values: usize,
 ) -> fmi3Status {
-    call(instance, "fmi3SetFloat64", |inst| inst.set("fmi3SetFloat64", Type::Float64, valueReferences, nValueReferences, values, nValues, |x: f64| Some(x)))
+    call(instance, F::SetFloat64, |inst| inst.set(F::SetFloat64, Type::Float64, vrs, n_vrs, values, n_values, Some))
 }
 const _: fmi3SetFloat64TYPE = Some(fmi3SetFloat64);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetInt8(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *mut fmi3Int8,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3GetInt8", |inst| no_variables(inst, "fmi3GetInt8", "Int8", valueReferences, nValueReferences, mask::GET))
+pub unsafe extern "C" fn fmi3GetInt8(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *mut fmi3Int8, _b: usize) -> fmi3Status {
+    call(instance, F::GetInt8, |inst| unsafe { inst.no_variables(F::GetInt8, "Int8", vrs, n_vrs) })
 }
 const _: fmi3GetInt8TYPE = Some(fmi3GetInt8);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetInt8(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *const fmi3Int8,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3SetInt8", |inst| no_variables(inst, "fmi3SetInt8", "Int8", valueReferences, nValueReferences, mask::SET))
+pub unsafe extern "C" fn fmi3SetInt8(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *const fmi3Int8, _b: usize) -> fmi3Status {
+    call(instance, F::SetInt8, |inst| unsafe { inst.no_variables(F::SetInt8, "Int8", vrs, n_vrs) })
 }
 const _: fmi3SetInt8TYPE = Some(fmi3SetInt8);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetUInt8(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *mut fmi3UInt8,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3GetUInt8", |inst| no_variables(inst, "fmi3GetUInt8", "UInt8", valueReferences, nValueReferences, mask::GET))
+pub unsafe extern "C" fn fmi3GetUInt8(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *mut fmi3UInt8, _b: usize) -> fmi3Status {
+    call(instance, F::GetUInt8, |inst| unsafe { inst.no_variables(F::GetUInt8, "UInt8", vrs, n_vrs) })
 }
 const _: fmi3GetUInt8TYPE = Some(fmi3GetUInt8);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetUInt8(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *const fmi3UInt8,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3SetUInt8", |inst| no_variables(inst, "fmi3SetUInt8", "UInt8", valueReferences, nValueReferences, mask::SET))
+pub unsafe extern "C" fn fmi3SetUInt8(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *const fmi3UInt8, _b: usize) -> fmi3Status {
+    call(instance, F::SetUInt8, |inst| unsafe { inst.no_variables(F::SetUInt8, "UInt8", vrs, n_vrs) })
 }
 const _: fmi3SetUInt8TYPE = Some(fmi3SetUInt8);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetInt16(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *mut fmi3Int16,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3GetInt16", |inst| no_variables(inst, "fmi3GetInt16", "Int16", valueReferences, nValueReferences, mask::GET))
+pub unsafe extern "C" fn fmi3GetInt16(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *mut fmi3Int16, _b: usize) -> fmi3Status {
+    call(instance, F::GetInt16, |inst| unsafe { inst.no_variables(F::GetInt16, "Int16", vrs, n_vrs) })
 }
 const _: fmi3GetInt16TYPE = Some(fmi3GetInt16);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetInt16(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *const fmi3Int16,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3SetInt16", |inst| no_variables(inst, "fmi3SetInt16", "Int16", valueReferences, nValueReferences, mask::SET))
+pub unsafe extern "C" fn fmi3SetInt16(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *const fmi3Int16, _b: usize) -> fmi3Status {
+    call(instance, F::SetInt16, |inst| unsafe { inst.no_variables(F::SetInt16, "Int16", vrs, n_vrs) })
 }
 const _: fmi3SetInt16TYPE = Some(fmi3SetInt16);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetUInt16(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *mut fmi3UInt16,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3GetUInt16", |inst| no_variables(inst, "fmi3GetUInt16", "UInt16", valueReferences, nValueReferences, mask::GET))
+pub unsafe extern "C" fn fmi3GetUInt16(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *mut fmi3UInt16, _b: usize) -> fmi3Status {
+    call(instance, F::GetUInt16, |inst| unsafe { inst.no_variables(F::GetUInt16, "UInt16", vrs, n_vrs) })
 }
 const _: fmi3GetUInt16TYPE = Some(fmi3GetUInt16);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetUInt16(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *const fmi3UInt16,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3SetUInt16", |inst| no_variables(inst, "fmi3SetUInt16", "UInt16", valueReferences, nValueReferences, mask::SET))
+pub unsafe extern "C" fn fmi3SetUInt16(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *const fmi3UInt16, _b: usize) -> fmi3Status {
+    call(instance, F::SetUInt16, |inst| unsafe { inst.no_variables(F::SetUInt16, "UInt16", vrs, n_vrs) })
 }
 const _: fmi3SetUInt16TYPE = Some(fmi3SetUInt16);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetInt32(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *mut fmi3Int32,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3GetInt32", |inst| no_variables(inst, "fmi3GetInt32", "Int32", valueReferences, nValueReferences, mask::GET))
+pub unsafe extern "C" fn fmi3GetInt32(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *mut fmi3Int32, _b: usize) -> fmi3Status {
+    call(instance, F::GetInt32, |inst| unsafe { inst.no_variables(F::GetInt32, "Int32", vrs, n_vrs) })
 }
 const _: fmi3GetInt32TYPE = Some(fmi3GetInt32);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetInt32(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *const fmi3Int32,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3SetInt32", |inst| no_variables(inst, "fmi3SetInt32", "Int32", valueReferences, nValueReferences, mask::SET))
+pub unsafe extern "C" fn fmi3SetInt32(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *const fmi3Int32, _b: usize) -> fmi3Status {
+    call(instance, F::SetInt32, |inst| unsafe { inst.no_variables(F::SetInt32, "Int32", vrs, n_vrs) })
 }
 const _: fmi3SetInt32TYPE = Some(fmi3SetInt32);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetUInt32(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *mut fmi3UInt32,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3GetUInt32", |inst| no_variables(inst, "fmi3GetUInt32", "UInt32", valueReferences, nValueReferences, mask::GET))
+pub unsafe extern "C" fn fmi3GetUInt32(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *mut fmi3UInt32, _b: usize) -> fmi3Status {
+    call(instance, F::GetUInt32, |inst| unsafe { inst.no_variables(F::GetUInt32, "UInt32", vrs, n_vrs) })
 }
 const _: fmi3GetUInt32TYPE = Some(fmi3GetUInt32);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetUInt32(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *const fmi3UInt32,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3SetUInt32", |inst| no_variables(inst, "fmi3SetUInt32", "UInt32", valueReferences, nValueReferences, mask::SET))
+pub unsafe extern "C" fn fmi3SetUInt32(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *const fmi3UInt32, _b: usize) -> fmi3Status {
+    call(instance, F::SetUInt32, |inst| unsafe { inst.no_variables(F::SetUInt32, "UInt32", vrs, n_vrs) })
 }
 const _: fmi3SetUInt32TYPE = Some(fmi3SetUInt32);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3GetInt64(
     instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
+    vrs: *const fmi3ValueReference,
+    n_vrs: usize,
     values: *mut fmi3Int64,
-    nValues: usize,
+    n_values: usize,
 ) -> fmi3Status {
-    call(instance, "fmi3GetInt64", |inst| inst.get("fmi3GetInt64", Type::Int64, valueReferences, nValueReferences, values, nValues, |x| x as i64))
+    call(instance, F::GetInt64, |inst| inst.get(F::GetInt64, Type::Int64, vrs, n_vrs, values, n_values, |x| x as i64))
 }
 const _: fmi3GetInt64TYPE = Some(fmi3GetInt64);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3SetInt64(
     instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
+    vrs: *const fmi3ValueReference,
+    n_vrs: usize,
     values: *const fmi3Int64,
-    nValues: usize,
+    n_values: usize,
 ) -> fmi3Status {
-    call(instance, "fmi3SetInt64", |inst| {
-        inst.set("fmi3SetInt64", Type::Int64, valueReferences, nValueReferences, values, nValues, |x: i64| (x.unsigned_abs() <= 1 << 53).then_some(x as f64))
+    call(instance, F::SetInt64, |inst| {
+        inst.set(F::SetInt64, Type::Int64, vrs, n_vrs, values, n_values, |x: i64| (x.unsigned_abs() <= 1 << 53).then_some(x as f64))
     })
 }
 const _: fmi3SetInt64TYPE = Some(fmi3SetInt64);
@@ -461,524 +300,398 @@ const _: fmi3SetInt64TYPE = Some(fmi3SetInt64);
 #[no_mangle]
 pub unsafe extern "C" fn fmi3GetUInt64(
     instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
+    vrs: *const fmi3ValueReference,
+    n_vrs: usize,
     values: *mut fmi3UInt64,
-    nValues: usize,
+    n_values: usize,
 ) -> fmi3Status {
-    call(instance, "fmi3GetUInt64", |inst| inst.get("fmi3GetUInt64", Type::UInt64, valueReferences, nValueReferences, values, nValues, |x| x as u64))
+    call(instance, F::GetUInt64, |inst| inst.get(F::GetUInt64, Type::UInt64, vrs, n_vrs, values, n_values, |x| x as u64))
 }
 const _: fmi3GetUInt64TYPE = Some(fmi3GetUInt64);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3SetUInt64(
     instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
+    vrs: *const fmi3ValueReference,
+    n_vrs: usize,
     values: *const fmi3UInt64,
-    nValues: usize,
+    n_values: usize,
 ) -> fmi3Status {
-    call(instance, "fmi3SetUInt64", |inst| {
-        inst.set("fmi3SetUInt64", Type::UInt64, valueReferences, nValueReferences, values, nValues, |x: u64| (x <= 1 << 53).then_some(x as f64))
-    })
+    call(instance, F::SetUInt64, |inst| inst.set(F::SetUInt64, Type::UInt64, vrs, n_vrs, values, n_values, |x: u64| (x <= 1 << 53).then_some(x as f64)))
 }
 const _: fmi3SetUInt64TYPE = Some(fmi3SetUInt64);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3GetBoolean(
     instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
+    vrs: *const fmi3ValueReference,
+    n_vrs: usize,
     values: *mut fmi3Boolean,
-    nValues: usize,
+    n_values: usize,
 ) -> fmi3Status {
-    call(instance, "fmi3GetBoolean", |inst| inst.get("fmi3GetBoolean", Type::Boolean, valueReferences, nValueReferences, values, nValues, |x| x != 0.0))
+    call(instance, F::GetBoolean, |inst| inst.get(F::GetBoolean, Type::Boolean, vrs, n_vrs, values, n_values, |x| x != 0.0))
 }
 const _: fmi3GetBooleanTYPE = Some(fmi3GetBoolean);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3SetBoolean(
     instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
+    vrs: *const fmi3ValueReference,
+    n_vrs: usize,
     values: *const fmi3Boolean,
-    nValues: usize,
+    n_values: usize,
 ) -> fmi3Status {
     // Read as bytes: a host may pass any non-zero value for true.
     let bytes = values as *const u8;
-    call(instance, "fmi3SetBoolean", |inst| {
-        inst.set("fmi3SetBoolean", Type::Boolean, valueReferences, nValueReferences, bytes, nValues, |x: u8| Some(if x != 0 { 1.0 } else { 0.0 }))
-    })
+    call(instance, F::SetBoolean, |inst| inst.set(F::SetBoolean, Type::Boolean, vrs, n_vrs, bytes, n_values, |x: u8| Some(if x != 0 { 1.0 } else { 0.0 })))
 }
 const _: fmi3SetBooleanTYPE = Some(fmi3SetBoolean);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetString(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *mut fmi3String,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3GetString", |inst| no_variables(inst, "fmi3GetString", "String", valueReferences, nValueReferences, mask::GET))
+pub unsafe extern "C" fn fmi3GetString(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *mut fmi3String, _b: usize) -> fmi3Status {
+    call(instance, F::GetString, |inst| unsafe { inst.no_variables(F::GetString, "String", vrs, n_vrs) })
 }
 const _: fmi3GetStringTYPE = Some(fmi3GetString);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetString(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *const fmi3String,
-    nValues: usize,
-) -> fmi3Status {
-    let _ = (values, nValues);
-    call(instance, "fmi3SetString", |inst| no_variables(inst, "fmi3SetString", "String", valueReferences, nValueReferences, mask::SET))
+pub unsafe extern "C" fn fmi3SetString(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *const fmi3String, _b: usize) -> fmi3Status {
+    call(instance, F::SetString, |inst| unsafe { inst.no_variables(F::SetString, "String", vrs, n_vrs) })
 }
 const _: fmi3SetStringTYPE = Some(fmi3SetString);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3GetBinary(
     instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    valueSizes: *mut usize,
-    values: *mut fmi3Binary,
-    nValues: usize,
+    vrs: *const fmi3ValueReference,
+    n_vrs: usize,
+    _a: *mut usize,
+    _b: *mut fmi3Binary,
+    _c: usize,
 ) -> fmi3Status {
-    let _ = (valueSizes, values, nValues);
-    call(instance, "fmi3GetBinary", |inst| no_variables(inst, "fmi3GetBinary", "Binary", valueReferences, nValueReferences, mask::GET))
+    call(instance, F::GetBinary, |inst| unsafe { inst.no_variables(F::GetBinary, "Binary", vrs, n_vrs) })
 }
 const _: fmi3GetBinaryTYPE = Some(fmi3GetBinary);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3SetBinary(
     instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    valueSizes: *const usize,
-    values: *const fmi3Binary,
-    nValues: usize,
+    vrs: *const fmi3ValueReference,
+    n_vrs: usize,
+    _a: *const usize,
+    _b: *const fmi3Binary,
+    _c: usize,
 ) -> fmi3Status {
-    let _ = (valueSizes, values, nValues);
-    call(instance, "fmi3SetBinary", |inst| no_variables(inst, "fmi3SetBinary", "Binary", valueReferences, nValueReferences, mask::SET))
+    call(instance, F::SetBinary, |inst| unsafe { inst.no_variables(F::SetBinary, "Binary", vrs, n_vrs) })
 }
 const _: fmi3SetBinaryTYPE = Some(fmi3SetBinary);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetClock(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *mut fmi3Clock,
-) -> fmi3Status {
-    let _ = values;
-    call(instance, "fmi3GetClock", |inst| no_variables(inst, "fmi3GetClock", "Clock", valueReferences, nValueReferences, mask::GET))
+pub unsafe extern "C" fn fmi3GetClock(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *mut fmi3Clock) -> fmi3Status {
+    call(instance, F::GetClock, |inst| unsafe { inst.no_variables(F::GetClock, "Clock", vrs, n_vrs) })
 }
 const _: fmi3GetClockTYPE = Some(fmi3GetClock);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetClock(
-    instance: fmi3Instance,
-    valueReferences: *const fmi3ValueReference,
-    nValueReferences: usize,
-    values: *const fmi3Clock,
-) -> fmi3Status {
-    let _ = values;
-    call(instance, "fmi3SetClock", |inst| no_variables(inst, "fmi3SetClock", "Clock", valueReferences, nValueReferences, mask::SET))
+pub unsafe extern "C" fn fmi3SetClock(instance: fmi3Instance, vrs: *const fmi3ValueReference, n_vrs: usize, _a: *const fmi3Clock) -> fmi3Status {
+    call(instance, F::SetClock, |inst| unsafe { inst.no_variables(F::SetClock, "Clock", vrs, n_vrs) })
 }
 const _: fmi3SetClockTYPE = Some(fmi3SetClock);
 
-// ---- Variable dependencies ----------------------------------------------------
-
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetNumberOfVariableDependencies(
-    instance: fmi3Instance,
-    _valueReference: fmi3ValueReference,
-    _nDependencies: *mut usize,
-) -> fmi3Status {
-    unsupported(instance, "fmi3GetNumberOfVariableDependencies", "variable dependencies are not provided (every output depends on every parameter)")
+pub unsafe extern "C" fn fmi3GetNumberOfVariableDependencies(instance: fmi3Instance, _a: fmi3ValueReference, _b: *mut usize) -> fmi3Status {
+    refuse(instance, F::GetNumberOfVariableDependencies)
 }
 const _: fmi3GetNumberOfVariableDependenciesTYPE = Some(fmi3GetNumberOfVariableDependencies);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3GetVariableDependencies(
     instance: fmi3Instance,
-    _dependent: fmi3ValueReference,
-    _elementIndicesOfDependent: *mut usize,
-    _independents: *mut fmi3ValueReference,
-    _elementIndicesOfIndependents: *mut usize,
-    _dependencyKinds: *mut fmi3DependencyKind,
-    _nDependencies: usize,
+    _a: fmi3ValueReference,
+    _b: *mut usize,
+    _c: *mut fmi3ValueReference,
+    _d: *mut usize,
+    _e: *mut fmi3DependencyKind,
+    _f: usize,
 ) -> fmi3Status {
-    unsupported(instance, "fmi3GetVariableDependencies", "variable dependencies are not provided (every output depends on every parameter)")
+    refuse(instance, F::GetVariableDependencies)
 }
 const _: fmi3GetVariableDependenciesTYPE = Some(fmi3GetVariableDependencies);
 
-// ---- FMU state ---------------------------------------------------------------
-
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status {
-    call(instance, "fmi3GetFMUState", |inst| {
-        inst.guard("fmi3GetFMUState", mask::ANY)?;
-        let s = inst.capture();
-        unsafe { inst.store_state("fmi3GetFMUState", FMUState, s) }
-    })
+pub unsafe extern "C" fn fmi3GetFMUState(instance: fmi3Instance, state: *mut fmi3FMUState) -> fmi3Status {
+    call(instance, F::GetFMUState, |inst| unsafe { inst.store_state("fmi3GetFMUState", state, inst.capture()) })
 }
 const _: fmi3GetFMUStateTYPE = Some(fmi3GetFMUState);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetFMUState(instance: fmi3Instance, FMUState: fmi3FMUState) -> fmi3Status {
-    call(instance, "fmi3SetFMUState", |inst| {
-        inst.guard("fmi3SetFMUState", mask::ANY)?;
-        let s = inst.state_from_ptr("fmi3SetFMUState", FMUState)?.clone();
-        inst.restore(&s)
-    })
+pub unsafe extern "C" fn fmi3SetFMUState(instance: fmi3Instance, state: fmi3FMUState) -> fmi3Status {
+    call(instance, F::SetFMUState, |inst| inst.restore(&inst.state_from_ptr("fmi3SetFMUState", state)?.clone()))
 }
 const _: fmi3SetFMUStateTYPE = Some(fmi3SetFMUState);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3FreeFMUState(instance: fmi3Instance, FMUState: *mut fmi3FMUState) -> fmi3Status {
-    call(instance, "fmi3FreeFMUState", |inst| unsafe { inst.free_state(FMUState) })
+pub unsafe extern "C" fn fmi3FreeFMUState(instance: fmi3Instance, state: *mut fmi3FMUState) -> fmi3Status {
+    call(instance, F::FreeFMUState, |inst| unsafe { inst.free_state(state) })
 }
 const _: fmi3FreeFMUStateTYPE = Some(fmi3FreeFMUState);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SerializedFMUStateSize(instance: fmi3Instance, FMUState: fmi3FMUState, size: *mut usize) -> fmi3Status {
-    call(instance, "fmi3SerializedFMUStateSize", |inst| {
-        if size.is_null() {
-            return Err(inst.fail("fmi3SerializedFMUStateSize: size is NULL"));
-        }
-        let s = inst.state_from_ptr("fmi3SerializedFMUStateSize", FMUState)?;
-        unsafe { *size = serialize::encode(s).len() };
-        Ok(OK)
-    })
+pub unsafe extern "C" fn fmi3SerializedFMUStateSize(instance: fmi3Instance, state: fmi3FMUState, size: *mut usize) -> fmi3Status {
+    call(instance, F::SerializedFMUStateSize, |inst| unsafe { inst.serialized_size(state, size) })
 }
 const _: fmi3SerializedFMUStateSizeTYPE = Some(fmi3SerializedFMUStateSize);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SerializeFMUState(instance: fmi3Instance, FMUState: fmi3FMUState, serializedState: *mut fmi3Byte, size: usize) -> fmi3Status {
-    call(instance, "fmi3SerializeFMUState", |inst| {
-        let s = inst.state_from_ptr("fmi3SerializeFMUState", FMUState)?;
-        let bytes = serialize::encode(s);
-        if serializedState.is_null() {
-            return Err(inst.fail("fmi3SerializeFMUState: serializedState is NULL"));
-        }
-        if size != bytes.len() {
-            return Err(inst.fail(&format!("fmi3SerializeFMUState: size is {size}, fmi3SerializedFMUStateSize gave {}", bytes.len())));
-        }
-        unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), serializedState, size) };
-        Ok(OK)
-    })
+pub unsafe extern "C" fn fmi3SerializeFMUState(instance: fmi3Instance, state: fmi3FMUState, bytes: *mut fmi3Byte, size: usize) -> fmi3Status {
+    call(instance, F::SerializeFMUState, |inst| unsafe { inst.serialize(state, bytes, size) })
 }
 const _: fmi3SerializeFMUStateTYPE = Some(fmi3SerializeFMUState);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3DeserializeFMUState(
-    instance: fmi3Instance,
-    serializedState: *const fmi3Byte,
-    size: usize,
-    FMUState: *mut fmi3FMUState,
-) -> fmi3Status {
-    call(instance, "fmi3DeserializeFMUState", |inst| {
-        if serializedState.is_null() || FMUState.is_null() {
-            return Err(inst.fail("fmi3DeserializeFMUState: serializedState or FMUState is NULL"));
-        }
-        if too_many::<fmi3Byte>(size) {
-            return Err(inst.fail(&format!("fmi3DeserializeFMUState: size = {size} cannot be an array size")));
-        }
-        let bytes = unsafe { slice(serializedState, size) };
-        let s = serialize::decode(bytes).map_err(|m| inst.fail(&format!("fmi3DeserializeFMUState: {m}")))?;
-        let mine = inst.structural();
-        let theirs: Vec<_> = mine.iter().map(|(n, _)| (*n, s.params.get(super::variables::VARIABLES.iter().find(|v| v.name == *n).unwrap().vr)[0])).collect();
-        if mine != theirs {
-            return Err(
-                inst.fail(&format!("fmi3DeserializeFMUState: the state is from an instance with structural parameters {theirs:?}, this one has {mine:?}"))
-            );
-        }
-        unsafe { inst.store_state("fmi3DeserializeFMUState", FMUState, s) }
-    })
+pub unsafe extern "C" fn fmi3DeserializeFMUState(instance: fmi3Instance, bytes: *const fmi3Byte, size: usize, state: *mut fmi3FMUState) -> fmi3Status {
+    call(instance, F::DeserializeFMUState, |inst| unsafe { inst.deserialize(bytes, size, state) })
 }
 const _: fmi3DeserializeFMUStateTYPE = Some(fmi3DeserializeFMUState);
-
-// ---- Partial derivatives -----------------------------------------------------
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3GetDirectionalDerivative(
     instance: fmi3Instance,
-    _unknowns: *const fmi3ValueReference,
-    _nUnknowns: usize,
-    _knowns: *const fmi3ValueReference,
-    _nKnowns: usize,
-    _seed: *const fmi3Float64,
-    _nSeed: usize,
-    _sensitivity: *mut fmi3Float64,
-    _nSensitivity: usize,
+    _a: *const fmi3ValueReference,
+    _b: usize,
+    _c: *const fmi3ValueReference,
+    _d: usize,
+    _e: *const fmi3Float64,
+    _f: usize,
+    _g: *mut fmi3Float64,
+    _h: usize,
 ) -> fmi3Status {
-    unsupported(instance, "fmi3GetDirectionalDerivative", "directional derivatives are not provided (providesDirectionalDerivatives = false)")
+    refuse(instance, F::GetDirectionalDerivative)
 }
 const _: fmi3GetDirectionalDerivativeTYPE = Some(fmi3GetDirectionalDerivative);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3GetAdjointDerivative(
     instance: fmi3Instance,
-    _unknowns: *const fmi3ValueReference,
-    _nUnknowns: usize,
-    _knowns: *const fmi3ValueReference,
-    _nKnowns: usize,
-    _seed: *const fmi3Float64,
-    _nSeed: usize,
-    _sensitivity: *mut fmi3Float64,
-    _nSensitivity: usize,
+    _a: *const fmi3ValueReference,
+    _b: usize,
+    _c: *const fmi3ValueReference,
+    _d: usize,
+    _e: *const fmi3Float64,
+    _f: usize,
+    _g: *mut fmi3Float64,
+    _h: usize,
 ) -> fmi3Status {
-    unsupported(instance, "fmi3GetAdjointDerivative", "adjoint derivatives are not provided (providesAdjointDerivatives = false)")
+    refuse(instance, F::GetAdjointDerivative)
 }
 const _: fmi3GetAdjointDerivativeTYPE = Some(fmi3GetAdjointDerivative);
 
-// ---- Configuration Mode ------------------------------------------------------
-
 #[no_mangle]
 pub unsafe extern "C" fn fmi3EnterConfigurationMode(instance: fmi3Instance) -> fmi3Status {
-    call(instance, "fmi3EnterConfigurationMode", |inst| inst.enter_configuration_mode())
+    call(instance, F::EnterConfigurationMode, |inst| inst.enter_configuration_mode())
 }
 const _: fmi3EnterConfigurationModeTYPE = Some(fmi3EnterConfigurationMode);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3ExitConfigurationMode(instance: fmi3Instance) -> fmi3Status {
-    call(instance, "fmi3ExitConfigurationMode", |inst| inst.exit_configuration_mode())
+    call(instance, F::ExitConfigurationMode, |inst| inst.exit_configuration_mode())
 }
 const _: fmi3ExitConfigurationModeTYPE = Some(fmi3ExitConfigurationMode);
-
-// ---- Clocks ------------------------------------------------------------------
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3GetIntervalDecimal(
     instance: fmi3Instance,
-    _valueReferences: *const fmi3ValueReference,
-    _nValueReferences: usize,
-    _intervals: *mut fmi3Float64,
-    _qualifiers: *mut fmi3IntervalQualifier,
+    _a: *const fmi3ValueReference,
+    _b: usize,
+    _c: *mut fmi3Float64,
+    _d: *mut fmi3IntervalQualifier,
 ) -> fmi3Status {
-    unsupported(instance, "fmi3GetIntervalDecimal", NO_CLOCKS)
+    refuse(instance, F::GetIntervalDecimal)
 }
 const _: fmi3GetIntervalDecimalTYPE = Some(fmi3GetIntervalDecimal);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3GetIntervalFraction(
     instance: fmi3Instance,
-    _valueReferences: *const fmi3ValueReference,
-    _nValueReferences: usize,
-    _counters: *mut fmi3UInt64,
-    _resolutions: *mut fmi3UInt64,
-    _qualifiers: *mut fmi3IntervalQualifier,
+    _a: *const fmi3ValueReference,
+    _b: usize,
+    _c: *mut fmi3UInt64,
+    _d: *mut fmi3UInt64,
+    _e: *mut fmi3IntervalQualifier,
 ) -> fmi3Status {
-    unsupported(instance, "fmi3GetIntervalFraction", NO_CLOCKS)
+    refuse(instance, F::GetIntervalFraction)
 }
 const _: fmi3GetIntervalFractionTYPE = Some(fmi3GetIntervalFraction);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetShiftDecimal(
-    instance: fmi3Instance,
-    _valueReferences: *const fmi3ValueReference,
-    _nValueReferences: usize,
-    _shifts: *mut fmi3Float64,
-) -> fmi3Status {
-    unsupported(instance, "fmi3GetShiftDecimal", NO_CLOCKS)
+pub unsafe extern "C" fn fmi3GetShiftDecimal(instance: fmi3Instance, _a: *const fmi3ValueReference, _b: usize, _c: *mut fmi3Float64) -> fmi3Status {
+    refuse(instance, F::GetShiftDecimal)
 }
 const _: fmi3GetShiftDecimalTYPE = Some(fmi3GetShiftDecimal);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3GetShiftFraction(
     instance: fmi3Instance,
-    _valueReferences: *const fmi3ValueReference,
-    _nValueReferences: usize,
-    _counters: *mut fmi3UInt64,
-    _resolutions: *mut fmi3UInt64,
+    _a: *const fmi3ValueReference,
+    _b: usize,
+    _c: *mut fmi3UInt64,
+    _d: *mut fmi3UInt64,
 ) -> fmi3Status {
-    unsupported(instance, "fmi3GetShiftFraction", NO_CLOCKS)
+    refuse(instance, F::GetShiftFraction)
 }
 const _: fmi3GetShiftFractionTYPE = Some(fmi3GetShiftFraction);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetIntervalDecimal(
-    instance: fmi3Instance,
-    _valueReferences: *const fmi3ValueReference,
-    _nValueReferences: usize,
-    _intervals: *const fmi3Float64,
-) -> fmi3Status {
-    unsupported(instance, "fmi3SetIntervalDecimal", NO_CLOCKS)
+pub unsafe extern "C" fn fmi3SetIntervalDecimal(instance: fmi3Instance, _a: *const fmi3ValueReference, _b: usize, _c: *const fmi3Float64) -> fmi3Status {
+    refuse(instance, F::SetIntervalDecimal)
 }
 const _: fmi3SetIntervalDecimalTYPE = Some(fmi3SetIntervalDecimal);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3SetIntervalFraction(
     instance: fmi3Instance,
-    _valueReferences: *const fmi3ValueReference,
-    _nValueReferences: usize,
-    _counters: *const fmi3UInt64,
-    _resolutions: *const fmi3UInt64,
+    _a: *const fmi3ValueReference,
+    _b: usize,
+    _c: *const fmi3UInt64,
+    _d: *const fmi3UInt64,
 ) -> fmi3Status {
-    unsupported(instance, "fmi3SetIntervalFraction", NO_CLOCKS)
+    refuse(instance, F::SetIntervalFraction)
 }
 const _: fmi3SetIntervalFractionTYPE = Some(fmi3SetIntervalFraction);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetShiftDecimal(
-    instance: fmi3Instance,
-    _valueReferences: *const fmi3ValueReference,
-    _nValueReferences: usize,
-    _shifts: *const fmi3Float64,
-) -> fmi3Status {
-    unsupported(instance, "fmi3SetShiftDecimal", NO_CLOCKS)
+pub unsafe extern "C" fn fmi3SetShiftDecimal(instance: fmi3Instance, _a: *const fmi3ValueReference, _b: usize, _c: *const fmi3Float64) -> fmi3Status {
+    refuse(instance, F::SetShiftDecimal)
 }
 const _: fmi3SetShiftDecimalTYPE = Some(fmi3SetShiftDecimal);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3SetShiftFraction(
     instance: fmi3Instance,
-    _valueReferences: *const fmi3ValueReference,
-    _nValueReferences: usize,
-    _counters: *const fmi3UInt64,
-    _resolutions: *const fmi3UInt64,
+    _a: *const fmi3ValueReference,
+    _b: usize,
+    _c: *const fmi3UInt64,
+    _d: *const fmi3UInt64,
 ) -> fmi3Status {
-    unsupported(instance, "fmi3SetShiftFraction", NO_CLOCKS)
+    refuse(instance, F::SetShiftFraction)
 }
 const _: fmi3SetShiftFractionTYPE = Some(fmi3SetShiftFraction);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3EvaluateDiscreteStates(instance: fmi3Instance) -> fmi3Status {
-    unsupported(instance, "fmi3EvaluateDiscreteStates", "discrete states are not provided (providesEvaluateDiscreteStates = false)")
+    refuse(instance, F::EvaluateDiscreteStates)
 }
 const _: fmi3EvaluateDiscreteStatesTYPE = Some(fmi3EvaluateDiscreteStates);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3UpdateDiscreteStates(
     instance: fmi3Instance,
-    _discreteStatesNeedUpdate: *mut fmi3Boolean,
-    _terminateSimulation: *mut fmi3Boolean,
-    _nominalsOfContinuousStatesChanged: *mut fmi3Boolean,
-    _valuesOfContinuousStatesChanged: *mut fmi3Boolean,
-    _nextEventTimeDefined: *mut fmi3Boolean,
-    _nextEventTime: *mut fmi3Float64,
+    _a: *mut fmi3Boolean,
+    _b: *mut fmi3Boolean,
+    _c: *mut fmi3Boolean,
+    _d: *mut fmi3Boolean,
+    _e: *mut fmi3Boolean,
+    _f: *mut fmi3Float64,
 ) -> fmi3Status {
-    unsupported(instance, "fmi3UpdateDiscreteStates", NO_EVENTS)
+    refuse(instance, F::UpdateDiscreteStates)
 }
 const _: fmi3UpdateDiscreteStatesTYPE = Some(fmi3UpdateDiscreteStates);
 
-// ---- Model Exchange ----------------------------------------------------------
-
 #[no_mangle]
 pub unsafe extern "C" fn fmi3EnterContinuousTimeMode(instance: fmi3Instance) -> fmi3Status {
-    unsupported(instance, "fmi3EnterContinuousTimeMode", NO_ME)
+    refuse(instance, F::EnterContinuousTimeMode)
 }
 const _: fmi3EnterContinuousTimeModeTYPE = Some(fmi3EnterContinuousTimeMode);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3CompletedIntegratorStep(
-    instance: fmi3Instance,
-    _noSetFMUStatePriorToCurrentPoint: fmi3Boolean,
-    _enterEventMode: *mut fmi3Boolean,
-    _terminateSimulation: *mut fmi3Boolean,
-) -> fmi3Status {
-    unsupported(instance, "fmi3CompletedIntegratorStep", NO_ME)
+pub unsafe extern "C" fn fmi3CompletedIntegratorStep(instance: fmi3Instance, _a: fmi3Boolean, _b: *mut fmi3Boolean, _c: *mut fmi3Boolean) -> fmi3Status {
+    refuse(instance, F::CompletedIntegratorStep)
 }
 const _: fmi3CompletedIntegratorStepTYPE = Some(fmi3CompletedIntegratorStep);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetTime(instance: fmi3Instance, _time: fmi3Float64) -> fmi3Status {
-    unsupported(instance, "fmi3SetTime", NO_ME)
+pub unsafe extern "C" fn fmi3SetTime(instance: fmi3Instance, _a: fmi3Float64) -> fmi3Status {
+    refuse(instance, F::SetTime)
 }
 const _: fmi3SetTimeTYPE = Some(fmi3SetTime);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetContinuousStates(instance: fmi3Instance, _continuousStates: *const fmi3Float64, _nContinuousStates: usize) -> fmi3Status {
-    unsupported(instance, "fmi3SetContinuousStates", NO_ME)
+pub unsafe extern "C" fn fmi3SetContinuousStates(instance: fmi3Instance, _a: *const fmi3Float64, _b: usize) -> fmi3Status {
+    refuse(instance, F::SetContinuousStates)
 }
 const _: fmi3SetContinuousStatesTYPE = Some(fmi3SetContinuousStates);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetContinuousStateDerivatives(instance: fmi3Instance, _derivatives: *mut fmi3Float64, _nContinuousStates: usize) -> fmi3Status {
-    unsupported(instance, "fmi3GetContinuousStateDerivatives", NO_ME)
+pub unsafe extern "C" fn fmi3GetContinuousStateDerivatives(instance: fmi3Instance, _a: *mut fmi3Float64, _b: usize) -> fmi3Status {
+    refuse(instance, F::GetContinuousStateDerivatives)
 }
 const _: fmi3GetContinuousStateDerivativesTYPE = Some(fmi3GetContinuousStateDerivatives);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetEventIndicators(instance: fmi3Instance, _eventIndicators: *mut fmi3Float64, _nEventIndicators: usize) -> fmi3Status {
-    unsupported(instance, "fmi3GetEventIndicators", NO_ME)
+pub unsafe extern "C" fn fmi3GetEventIndicators(instance: fmi3Instance, _a: *mut fmi3Float64, _b: usize) -> fmi3Status {
+    refuse(instance, F::GetEventIndicators)
 }
 const _: fmi3GetEventIndicatorsTYPE = Some(fmi3GetEventIndicators);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetContinuousStates(instance: fmi3Instance, _continuousStates: *mut fmi3Float64, _nContinuousStates: usize) -> fmi3Status {
-    unsupported(instance, "fmi3GetContinuousStates", NO_ME)
+pub unsafe extern "C" fn fmi3GetContinuousStates(instance: fmi3Instance, _a: *mut fmi3Float64, _b: usize) -> fmi3Status {
+    refuse(instance, F::GetContinuousStates)
 }
 const _: fmi3GetContinuousStatesTYPE = Some(fmi3GetContinuousStates);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetNominalsOfContinuousStates(instance: fmi3Instance, _nominals: *mut fmi3Float64, _nContinuousStates: usize) -> fmi3Status {
-    unsupported(instance, "fmi3GetNominalsOfContinuousStates", NO_ME)
+pub unsafe extern "C" fn fmi3GetNominalsOfContinuousStates(instance: fmi3Instance, _a: *mut fmi3Float64, _b: usize) -> fmi3Status {
+    refuse(instance, F::GetNominalsOfContinuousStates)
 }
 const _: fmi3GetNominalsOfContinuousStatesTYPE = Some(fmi3GetNominalsOfContinuousStates);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetNumberOfEventIndicators(instance: fmi3Instance, _nEventIndicators: *mut usize) -> fmi3Status {
-    unsupported(instance, "fmi3GetNumberOfEventIndicators", NO_ME)
+pub unsafe extern "C" fn fmi3GetNumberOfEventIndicators(instance: fmi3Instance, _a: *mut usize) -> fmi3Status {
+    refuse(instance, F::GetNumberOfEventIndicators)
 }
 const _: fmi3GetNumberOfEventIndicatorsTYPE = Some(fmi3GetNumberOfEventIndicators);
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3GetNumberOfContinuousStates(instance: fmi3Instance, _nContinuousStates: *mut usize) -> fmi3Status {
-    unsupported(instance, "fmi3GetNumberOfContinuousStates", NO_ME)
+pub unsafe extern "C" fn fmi3GetNumberOfContinuousStates(instance: fmi3Instance, _a: *mut usize) -> fmi3Status {
+    refuse(instance, F::GetNumberOfContinuousStates)
 }
 const _: fmi3GetNumberOfContinuousStatesTYPE = Some(fmi3GetNumberOfContinuousStates);
 
-// ---- Co-Simulation -----------------------------------------------------------
-
 #[no_mangle]
 pub unsafe extern "C" fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status {
-    unsupported(
-        instance,
-        "fmi3EnterStepMode",
-        "Step Mode is entered from Event Mode, which this FMU does not have (hasEventMode = false); fmi3ExitInitializationMode enters Step Mode",
-    )
+    refuse(instance, F::EnterStepMode)
 }
 const _: fmi3EnterStepModeTYPE = Some(fmi3EnterStepMode);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3GetOutputDerivatives(
     instance: fmi3Instance,
-    _valueReferences: *const fmi3ValueReference,
-    _nValueReferences: usize,
-    _orders: *const fmi3Int32,
-    _values: *mut fmi3Float64,
-    _nValues: usize,
+    _a: *const fmi3ValueReference,
+    _b: usize,
+    _c: *const fmi3Int32,
+    _d: *mut fmi3Float64,
+    _e: usize,
 ) -> fmi3Status {
-    unsupported(instance, "fmi3GetOutputDerivatives", "output derivatives are not provided (maxOutputDerivativeOrder = 0)")
+    refuse(instance, F::GetOutputDerivatives)
 }
 const _: fmi3GetOutputDerivativesTYPE = Some(fmi3GetOutputDerivatives);
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3DoStep(
     instance: fmi3Instance,
-    currentCommunicationPoint: fmi3Float64,
-    communicationStepSize: fmi3Float64,
-    _noSetFMUStatePriorToCurrentPoint: fmi3Boolean,
-    eventHandlingNeeded: *mut fmi3Boolean,
-    terminateSimulation: *mut fmi3Boolean,
-    earlyReturn: *mut fmi3Boolean,
-    lastSuccessfulTime: *mut fmi3Float64,
+    t: fmi3Float64,
+    h: fmi3Float64,
+    _a: fmi3Boolean,
+    event: *mut fmi3Boolean,
+    terminate: *mut fmi3Boolean,
+    early: *mut fmi3Boolean,
+    last: *mut fmi3Float64,
 ) -> fmi3Status {
-    call(instance, "fmi3DoStep", |inst| {
-        inst.do_step(currentCommunicationPoint, communicationStepSize, eventHandlingNeeded, terminateSimulation, earlyReturn, lastSuccessfulTime)
-    })
+    call(instance, F::DoStep, |inst| unsafe { inst.do_step(t, h, event, terminate, early, last) })
 }
 const _: fmi3DoStepTYPE = Some(fmi3DoStep);
 
-// ---- Scheduled Execution -----------------------------------------------------
-
 #[no_mangle]
-pub unsafe extern "C" fn fmi3ActivateModelPartition(instance: fmi3Instance, _clockReference: fmi3ValueReference, _activationTime: fmi3Float64) -> fmi3Status {
-    unsupported(instance, "fmi3ActivateModelPartition", NO_SE)
+pub unsafe extern "C" fn fmi3ActivateModelPartition(instance: fmi3Instance, _a: fmi3ValueReference, _b: fmi3Float64) -> fmi3Status {
+    refuse(instance, F::ActivateModelPartition)
 }
 const _: fmi3ActivateModelPartitionTYPE = Some(fmi3ActivateModelPartition);

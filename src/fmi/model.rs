@@ -1,12 +1,15 @@
-//! The model side of the FMU: parameter values -> [`Simulator`], simulator ->
-//! output values. Everything FMI-generic (state machine, checks, logging,
-//! serialization) lives in [`super::instance`].
+//! The model side of the FMU: variable values -> physics (grid, solver,
+//! loads, simulator), simulator -> output values. Everything FMI-generic
+//! (state machine, checks, logging, serialization) lives elsewhere in
+//! [`super`].
 
-use super::variables::{index_of, vr, Dim, Variable, VARIABLES};
-use crate::physics::{FixedNodes, Integrator, Reduction, SceneParams, SimError, Simulator, SolverParams, Tunables};
+use super::variables::{index_of, vr, Dim, Variability, Variable, SCENES, VARIABLES};
+use crate::options::{FixedNodes, Integrator, Reduction};
+use crate::physics::{Grid, Loads, PhysicsError, Simulator, SolverParams};
 
-/// Current values of the parameters, indexed like [`VARIABLES`] (empty for
-/// the other variables). Booleans are 0/1, integers exact (range-checked).
+/// Current values of the parameters and inputs, indexed like [`VARIABLES`]
+/// (empty for the other variables). Booleans are 0/1, integers exact
+/// (range-checked), enumerations their item values.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Params {
     pub values: Vec<Vec<f64>>,
@@ -15,32 +18,44 @@ pub struct Params {
 impl Params {
     /// Start values, arrays fitted to the start values of their structural parameters.
     pub fn start() -> Self {
-        let mut p = Params { values: VARIABLES.iter().map(|v| if v.is_parameter() { v.start.to_vec() } else { Vec::new() }).collect() };
+        let mut p = Params { values: VARIABLES.iter().map(|v| if v.holds_value() { v.start.to_vec() } else { Vec::new() }).collect() };
         p.fit_arrays();
         p
     }
 
+    /// The start values of the canonical scene `name` (the `[scenes.NAME]`
+    /// tables of `modelDescription/variables.toml`).
+    pub fn canonical(name: &str) -> Option<Self> {
+        let scene = SCENES.iter().find(|s| s.name == name)?;
+        let mut p = Params::start();
+        for (vr, values) in scene.values {
+            p.values[index_of(*vr).expect("scene variables exist")] = values.to_vec();
+        }
+        p.fit_arrays();
+        Some(p)
+    }
+
     /// Start values from `resources/startValues.txt` (`name value...` per
-    /// line, written by `cargo xtask fmu`); parameters not listed keep their
+    /// line, written by `cargo xtask fmu`); variables not listed keep their
     /// compiled start value. Every value is range-checked.
     pub fn from_text(text: &str) -> Result<Self, String> {
         let mut p = Params::start();
         for line in text.lines().map(str::trim).filter(|l| !l.is_empty() && !l.starts_with('#')) {
             let mut words = line.split_whitespace();
             let name = words.next().unwrap();
-            let i = VARIABLES.iter().position(|v| v.name == name && v.is_parameter()).ok_or(format!("{name} is not a parameter"))?;
+            let i = VARIABLES.iter().position(|v| v.name == name && v.holds_value()).ok_or(format!("{name} is not a parameter or input"))?;
             let values = words.map(|w| w.parse::<f64>().map_err(|_| format!("{name}: {w} is not a number"))).collect::<Result<Vec<_>, _>>()?;
             for x in &values {
-                super::instance::check_value(&VARIABLES[i], Some(*x)).map_err(|m| format!("{name} = {x}: {m}"))?;
+                super::values::check_value(&VARIABLES[i], Some(*x)).map_err(|m| format!("{name} = {x}: {m}"))?;
             }
             p.values[i] = values;
         }
-        for (i, v) in VARIABLES.iter().enumerate().filter(|(_, v)| v.is_parameter() && v.dims.is_empty()) {
+        for (i, v) in VARIABLES.iter().enumerate().filter(|(_, v)| v.holds_value() && v.dims.is_empty()) {
             if p.values[i].len() != 1 {
                 return Err(format!("{} needs one value", v.name));
             }
         }
-        for (i, v) in VARIABLES.iter().enumerate().filter(|(_, v)| v.is_parameter() && !v.dims.is_empty()) {
+        for (i, v) in VARIABLES.iter().enumerate().filter(|(_, v)| v.holds_value() && !v.dims.is_empty()) {
             if p.values[i].len() != p.size_of(v) {
                 if v.dims.iter().any(|d| matches!(d, Dim::Param(_))) && !text.lines().any(|l| l.split_whitespace().next() == Some(v.name)) {
                     continue; // fitted below
@@ -54,6 +69,13 @@ impl Params {
 
     pub fn get(&self, vr: u32) -> &[f64] {
         &self.values[index_of(vr).expect("known value reference")]
+    }
+
+    /// Sets the values of `vr` (unchecked; for tests and the study) and
+    /// fits the arrays a structural parameter sizes.
+    pub fn set(&mut self, vr: u32, values: &[f64]) {
+        self.values[index_of(vr).expect("known value reference")] = values.to_vec();
+        self.fit_arrays();
     }
 
     pub fn scalar(&self, vr: u32) -> f64 {
@@ -79,7 +101,7 @@ impl Params {
     /// existing prefix is kept, new elements repeat the first start value.
     pub fn fit_arrays(&mut self) {
         for (i, v) in VARIABLES.iter().enumerate() {
-            if v.is_parameter() && !v.dims.is_empty() {
+            if v.holds_value() && !v.dims.is_empty() {
                 let n = self.size_of(v);
                 if self.values[i].len() != n {
                     let fill = v.start.first().copied().unwrap_or(0.0);
@@ -89,43 +111,45 @@ impl Params {
         }
     }
 
-    /// True if the scene or solver of the two differ (tunables aside).
+    /// True if the fixed values (structural and fixed parameters: what the
+    /// set-up depends on) of the two are the same.
     pub fn same_fixed(&self, other: &Params) -> bool {
-        VARIABLES
-            .iter()
-            .enumerate()
-            .filter(|(_, v)| v.is_parameter() && v.variability != super::variables::Variability::Tunable)
-            .all(|(i, _)| self.values[i] == other.values[i])
+        VARIABLES.iter().enumerate().filter(|(_, v)| v.holds_value() && v.variability == Variability::Fixed).all(|(i, _)| self.values[i] == other.values[i])
     }
 
-    pub fn scene(&self) -> SceneParams {
-        SceneParams {
-            nx: self.count(vr::NX),
-            ny: self.count(vr::NY),
-            dimension: self.count(vr::DIMENSION),
+    fn enumeration<T>(&self, vr: u32, from_value: fn(i64) -> Option<T>) -> T {
+        from_value(self.scalar(vr) as i64).expect("enumeration values are range-checked")
+    }
+
+    /// The grid of `nx` x `ny` nodes these values describe.
+    pub fn grid(&self) -> Grid {
+        Grid {
+            columns: self.count(vr::NX),
+            rows: self.count(vr::NY),
+            dim: self.count(vr::DIMENSION),
             spacing: self.scalar(vr::SPACING),
             node_mass: self.scalar(vr::NODE_MASS),
             spring_stiffness: self.scalar(vr::SPRING_STIFFNESS),
             shear_springs: self.scalar(vr::SHEAR_SPRINGS) != 0.0,
             bending_springs: self.scalar(vr::BENDING_SPRINGS) != 0.0,
             aux_stiffness: self.scalar(vr::AUX_STIFFNESS),
-            fixed_nodes: if self.scalar(vr::FIXED_NODES) == 2.0 { FixedNodes::TopCorners } else { FixedNodes::TopRow },
+            fixed_nodes: self.enumeration(vr::FIXED_NODES, FixedNodes::from_value),
         }
     }
 
     pub fn solver(&self) -> SolverParams {
         SolverParams {
-            reduction: if self.scalar(vr::REDUCTION) == 2.0 { Reduction::Full } else { Reduction::Modal },
-            integrator: if self.scalar(vr::INTEGRATOR) == 2.0 { Integrator::NewmarkImplicit } else { Integrator::NewmarkExplicit },
+            reduction: self.enumeration(vr::REDUCTION, Reduction::from_value),
+            integrator: self.enumeration(vr::INTEGRATOR, Integrator::from_value),
             n_modes: self.count(vr::N_MODES),
             max_internal_step: self.scalar(vr::MAX_INTERNAL_STEP),
             substepping: true,
         }
     }
 
-    pub fn tunables(&self) -> Tunables {
+    pub fn loads(&self) -> Loads {
         let g = self.get(vr::GRAVITY);
-        Tunables {
+        Loads {
             gravity: [g[0], g[1], g[2]],
             damping_alpha: self.scalar(vr::DAMPING_ALPHA),
             damping_beta: self.scalar(vr::DAMPING_BETA),
@@ -133,9 +157,9 @@ impl Params {
         }
     }
 
-    /// Set-up (assembly, eigen decomposition); the error names the parameter.
-    pub fn build(&self) -> Result<Simulator, SimError> {
-        Simulator::new(&self.scene(), &self.solver(), &self.tunables())
+    /// Set-up: the grid, then the simulator (assembly, eigen decomposition).
+    pub fn build(&self) -> Result<Simulator, PhysicsError> {
+        Simulator::new(self.grid().build()?, &self.solver(), &self.loads())
     }
 }
 

@@ -6,20 +6,31 @@
 //! | 4 | format version |
 //! | 8 | fingerprint of the variable layout |
 //! | 8 | payload length |
-//! | n | payload: mode, start time, stop time, every parameter (vr, length, values), simulator snapshot |
+//! | n | payload: mode, start time, stop time, every parameter and input (vr, length, values), simulator snapshot (time, y, y', y'', loads) |
 //! | 4 | CRC-32 (IEEE) of everything before |
 //!
 //! Decoding checks all of it and every value against the model description,
 //! so a corrupted or foreign blob is refused instead of loaded.
 
-use super::instance::{check_value, FmuState, Mode};
+use fmi_sys::fmi3::{fmi3FMUState, fmi3Status};
+
+use super::fmu_state::FmuState;
+use super::instance::Instance;
 use super::model::Params;
+use super::ptr::{slice, too_many};
+use super::state_machine::Mode;
+use super::values::check_value;
 use super::variables::{index_of, LAYOUT_FINGERPRINT, VARIABLES};
-use crate::physics::{Snapshot, Tunables};
+use super::OK;
+use crate::physics::{Loads, Snapshot, State};
+
+type R = Result<fmi3Status, fmi3Status>;
 
 pub const MAGIC: &[u8; 8] = b"MMSFMU3S";
-/// 1: FNV-1a checksum, no stop time; 2: CRC-32, stop time.
-pub const VERSION: u32 = 2;
+/// 1: FNV-1a checksum, no stop time; 2: CRC-32, stop time; 3: the
+/// simulator state as time and three arrays (y, y', y'') instead of one
+/// concatenated array.
+pub const VERSION: u32 = 3;
 /// Bytes before the payload.
 pub const HEADER: usize = 8 + 4 + 8 + 8;
 /// Bytes after the payload.
@@ -58,7 +69,7 @@ pub fn payload(s: &FmuState) -> Vec<u8> {
             put_f64(&mut p, t);
         }
     }
-    let params: Vec<usize> = (0..VARIABLES.len()).filter(|&i| VARIABLES[i].is_parameter()).collect();
+    let params: Vec<usize> = (0..VARIABLES.len()).filter(|&i| VARIABLES[i].holds_value()).collect();
     put_u64(&mut p, params.len() as u64);
     for i in params {
         p.extend_from_slice(&VARIABLES[i].vr.to_le_bytes());
@@ -68,13 +79,16 @@ pub fn payload(s: &FmuState) -> Vec<u8> {
         None => p.push(0),
         Some(snap) => {
             p.push(1);
-            put_f64(&mut p, snap.time);
-            put_f64s(&mut p, &snap.state);
-            let t = &snap.tunables;
-            t.gravity.iter().for_each(|g| put_f64(&mut p, *g));
-            put_f64(&mut p, t.damping_alpha);
-            put_f64(&mut p, t.damping_beta);
-            put_f64s(&mut p, &t.mode_weights);
+            let s = &snap.state;
+            put_f64(&mut p, s.time);
+            put_f64s(&mut p, &s.y);
+            put_f64s(&mut p, &s.v);
+            put_f64s(&mut p, &s.a);
+            let l = &snap.loads;
+            l.gravity.iter().for_each(|g| put_f64(&mut p, *g));
+            put_f64(&mut p, l.damping_alpha);
+            put_f64(&mut p, l.damping_beta);
+            put_f64s(&mut p, &l.mode_weights);
         }
     }
     p
@@ -91,6 +105,9 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
         return Err("not a serialized state of this FMU (bad magic)".into());
     }
     let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
+    if version < VERSION {
+        return Err(format!("serialized state format {version} was written by an older version of this FMU; this version reads format {VERSION} only"));
+    }
     if version != VERSION {
         return Err(format!("serialized state format {version}, this FMU reads {VERSION}"));
     }
@@ -128,14 +145,14 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
     let mut seen = vec![false; VARIABLES.len()];
     for _ in 0..n {
         let vr = r.u32()?;
-        let i = index_of(vr).filter(|&i| VARIABLES[i].is_parameter()).ok_or(format!("value reference {vr} is not a parameter"))?;
+        let i = index_of(vr).filter(|&i| VARIABLES[i].holds_value()).ok_or(format!("value reference {vr} is not a parameter or input"))?;
         if std::mem::replace(&mut seen[i], true) {
             return Err(format!("{} appears twice", VARIABLES[i].name));
         }
         params.values[i] = r.f64s()?;
     }
     for (i, v) in VARIABLES.iter().enumerate() {
-        if v.is_parameter() {
+        if v.holds_value() {
             if !seen[i] {
                 return Err(format!("{} is missing", v.name));
             }
@@ -149,7 +166,7 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
         }
     }
     for (i, v) in VARIABLES.iter().enumerate() {
-        let want = if v.is_parameter() { params.size_of(v) } else { 0 };
+        let want = if v.holds_value() { params.size_of(v) } else { 0 };
         if params.values[i].len() != want {
             return Err(format!("{} holds {} values, expected {want}", v.name, params.values[i].len()));
         }
@@ -157,16 +174,18 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
     let snapshot = match r.u8()? {
         0 => None,
         1 => {
-            let time = r.f64()?;
-            let state = r.f64s()?;
+            let state = State { time: r.f64()?, y: r.f64s()?, v: r.f64s()?, a: r.f64s()? };
             let gravity = [r.f64()?, r.f64()?, r.f64()?];
             let damping_alpha = r.f64()?;
             let damping_beta = r.f64()?;
             let mode_weights = r.f64s()?;
-            if !(time.is_finite() && time >= 0.0) || !state.iter().all(|x| x.is_finite()) {
+            if !(state.is_finite() && state.time >= 0.0) {
                 return Err("the simulator state holds a negative or non-finite time or non-finite values".into());
             }
-            Some(Snapshot { time, state, tunables: Tunables { gravity, damping_alpha, damping_beta, mode_weights } })
+            if state.v.len() != state.y.len() || state.a.len() != state.y.len() {
+                return Err(format!("the simulator state holds arrays of {}, {} and {} values", state.y.len(), state.v.len(), state.a.len()));
+            }
+            Some(Snapshot { state, loads: Loads { gravity, damping_alpha, damping_beta, mode_weights } })
         }
         _ => return Err("bad snapshot flag".into()),
     };
@@ -177,14 +196,12 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
         return Err("a state after initialization must hold the simulator state".into());
     }
     if let Some(s) = &snapshot {
-        if s.tunables != params.tunables() {
-            return Err("simulator tunables differ from the parameters".into());
+        if s.loads != params.loads() {
+            return Err("the simulator's loads differ from the parameters".into());
         }
     }
-    if mode == Mode::Instantiated || mode == Mode::ConfigurationMode {
-        if stop_time.is_some() {
-            return Err("a state before initialization has no stop time".into());
-        }
+    if matches!(mode, Mode::Instantiated | Mode::ConfigurationMode) && stop_time.is_some() {
+        return Err("a state before initialization has no stop time".into());
     }
     Ok(FmuState::new(mode, start_time, stop_time, params, snapshot))
 }
@@ -232,5 +249,62 @@ impl Reader<'_> {
             return Err("truncated serialized state".into());
         }
         (0..n).map(|_| self.f64()).collect()
+    }
+}
+
+impl Instance {
+    /// fmi3SerializedFMUStateSize.
+    ///
+    /// # Safety
+    /// `size` must be NULL or writable.
+    pub unsafe fn serialized_size(&self, state: fmi3FMUState, size: *mut usize) -> R {
+        const F: &str = "fmi3SerializedFMUStateSize";
+        if size.is_null() {
+            return Err(self.log.fail(&format!("{F}: size is NULL")));
+        }
+        let s = self.state_from_ptr(F, state)?;
+        *size = encode(s).len();
+        Ok(OK)
+    }
+
+    /// fmi3SerializeFMUState: exactly the size fmi3SerializedFMUStateSize gave.
+    ///
+    /// # Safety
+    /// `out` must be NULL or point to `size` writable bytes.
+    pub unsafe fn serialize(&self, state: fmi3FMUState, out: *mut u8, size: usize) -> R {
+        const F: &str = "fmi3SerializeFMUState";
+        let s = self.state_from_ptr(F, state)?;
+        let bytes = encode(s);
+        if out.is_null() {
+            return Err(self.log.fail(&format!("{F}: serializedState is NULL")));
+        }
+        if size != bytes.len() {
+            return Err(self.log.fail(&format!("{F}: size is {size}, fmi3SerializedFMUStateSize gave {}", bytes.len())));
+        }
+        std::ptr::copy_nonoverlapping(bytes.as_ptr(), out, size);
+        Ok(OK)
+    }
+
+    /// fmi3DeserializeFMUState: a state of an instance with the same
+    /// structural parameters, checked through and through before it is kept.
+    ///
+    /// # Safety
+    /// `bytes` must be NULL or point to `size` readable bytes; `out` NULL or a
+    /// readable and writable state pointer.
+    pub unsafe fn deserialize(&mut self, bytes: *const u8, size: usize, out: *mut fmi3FMUState) -> R {
+        const F: &str = "fmi3DeserializeFMUState";
+        if bytes.is_null() || out.is_null() {
+            return Err(self.log.fail(&format!("{F}: serializedState or FMUState is NULL")));
+        }
+        if too_many::<u8>(size) {
+            return Err(self.log.fail(&format!("{F}: size = {size} cannot be an array size")));
+        }
+        let s = decode(slice(bytes, size)).map_err(|m| self.log.fail(&format!("{F}: {m}")))?;
+        let mine = self.structural();
+        let theirs: Vec<_> = mine.iter().map(|(n, _)| (*n, s.params.values[VARIABLES.iter().position(|v| v.name == *n).unwrap()][0])).collect();
+        if mine != theirs {
+            return Err(self.log.fail(&format!("{F}: the state is from an instance with structural parameters {theirs:?}, this one has {mine:?}")));
+        }
+        self.store_state(F, out, s)
     }
 }

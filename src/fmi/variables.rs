@@ -26,6 +26,7 @@ pub enum Causality {
     StructuralParameter,
     Parameter,
     CalculatedParameter,
+    Input,
     Output,
 }
 
@@ -63,13 +64,27 @@ pub struct Variable {
 }
 
 impl Variable {
-    /// Parameters hold a value in the instance; the rest come from the simulator.
-    pub fn is_parameter(&self) -> bool {
-        matches!(self.causality, Causality::StructuralParameter | Causality::Parameter)
+    /// Parameters and inputs hold a value in the instance (set by the host,
+    /// part of every FMU state); the rest come from the simulator.
+    pub fn holds_value(&self) -> bool {
+        matches!(self.causality, Causality::StructuralParameter | Causality::Parameter | Causality::Input)
     }
 }
 
+/// A canonical scene: the start values that differ from the defaults.
+#[derive(Debug)]
+pub struct CanonicalScene {
+    pub name: &'static str,
+    /// (value reference, values).
+    pub values: &'static [(u32, &'static [f64])],
+}
+
 include!(concat!(env!("OUT_DIR"), "/variables.rs"));
+
+/// Names of the canonical scenes.
+pub fn scene_names() -> impl Iterator<Item = &'static str> {
+    SCENES.iter().map(|s| s.name)
+}
 
 /// Index into [`VARIABLES`] of a value reference.
 pub fn index_of(vr: u32) -> Option<usize> {

@@ -1,7 +1,10 @@
-//! Spring forces (paper eq. 1), elastic energy and tangent stiffness.
+//! Spring forces (`docs/method.md`, section 2, paper eq. 1), elastic energy
+//! and tangent stiffness.
 //!
 //! Every kernel walks the spring list once and is monomorphised on the
-//! dimension `D`, so the inner loops have fixed length.
+//! dimension `D`, so the inner loops have fixed length. What is fixed after
+//! set-up (incidence lists, stiffnesses, sparsity) is apart from the scratch
+//! a force evaluation writes ([`SpringScratch`]).
 
 use super::scene::{Scene, Spring};
 
@@ -18,18 +21,22 @@ use super::scene::{Scene, Spring};
 ///
 /// Scattering each spring straight into f instead chains every update of a
 /// node through memory and keeps the divider scalar; it measured about twice
-/// as slow on the 2D paper scene. Incidence lists and buffers are made once
-/// per scene.
+/// as slow on the 2D paper scene. The incidence lists are made once per
+/// scene, the per-spring buffers once per simulator ([`SpringScratch`]).
 pub struct SpringForces {
     /// For free slot `s`: `springs[offsets[2s]..offsets[2s + 1]]` start there,
     /// `springs[offsets[2s + 1]..offsets[2s + 2]]` end there.
     offsets: Vec<u32>,
     springs: Vec<u32>,
     /// Per spring: stiffness, rest length (copied from the scene, flat,
-    /// padded to whole lanes with k = 0, l0 = 0, l^2 = 1).
+    /// padded to whole lanes with k = 0, l0 = 0).
     stiffness: Vec<f64>,
     rest: Vec<f64>,
-    /// Per spring: d, then g (`D` values each); |d|^2; t.
+}
+
+/// What one force evaluation writes per spring: d, then g (`D` values each);
+/// |d|^2 (padding lanes 1); t.
+pub struct SpringScratch {
     g: Vec<f64>,
     length_sq: Vec<f64>,
     tension: Vec<f64>,
@@ -71,21 +78,28 @@ impl SpringForces {
         let mut rest: Vec<f64> = scene.springs.iter().map(|s| s.rest).collect();
         stiffness.resize(padded, 0.0);
         rest.resize(padded, 0.0);
-        SpringForces { offsets, springs, stiffness, rest, g: vec![0.0; ns * scene.dim], length_sq: vec![1.0; padded], tension: vec![0.0; padded] }
+        SpringForces { offsets, springs, stiffness, rest }
     }
 
-    /// Adds the spring forces to `f` (the free DOFs) and returns the elastic
-    /// energy sum 1/2 k (l - l0)^2.
-    pub fn add_to(&mut self, scene: &Scene, x: &[f64], f: &mut [f64]) -> f64 {
+    /// Buffers for [`Self::add_to`] on `scene`.
+    pub fn scratch(&self, scene: &Scene) -> SpringScratch {
+        let padded = self.stiffness.len();
+        SpringScratch { g: vec![0.0; scene.springs.len() * scene.dim], length_sq: vec![1.0; padded], tension: vec![0.0; padded] }
+    }
+
+    /// Adds the spring forces at slot positions `x` to `f` (the free DOFs)
+    /// and returns the elastic energy sum 1/2 k (l - l0)^2.
+    pub fn add_to(&self, scene: &Scene, x: &[f64], scratch: &mut SpringScratch, f: &mut [f64]) -> f64 {
         match scene.dim {
-            2 => self.add_to_d::<2>(scene, x, f),
-            _ => self.add_to_d::<3>(scene, x, f),
+            2 => self.add_to_d::<2>(scene, x, scratch, f),
+            _ => self.add_to_d::<3>(scene, x, scratch, f),
         }
     }
 
-    fn add_to_d<const D: usize>(&mut self, scene: &Scene, x: &[f64], f: &mut [f64]) -> f64 {
+    fn add_to_d<const D: usize>(&self, scene: &Scene, x: &[f64], scratch: &mut SpringScratch, f: &mut [f64]) -> f64 {
+        let SpringScratch { g: gs, length_sq: length_sqs, tension: tensions } = scratch;
         // geometry
-        for ((s, d), l2) in scene.springs.iter().zip(self.g.chunks_exact_mut(D)).zip(&mut self.length_sq) {
+        for ((s, d), l2) in scene.springs.iter().zip(gs.chunks_exact_mut(D)).zip(length_sqs.iter_mut()) {
             let xa = &x[s.a * D..s.a * D + D];
             let xb = &x[s.b * D..s.b * D + D];
             let mut sum = 0.0;
@@ -97,8 +111,8 @@ impl SpringForces {
         }
         // tension
         let mut energy = [0.0; LANES];
-        let (tension, _) = self.tension.as_chunks_mut::<LANES>();
-        let (length_sq, _) = self.length_sq.as_chunks::<LANES>();
+        let (tension, _) = tensions.as_chunks_mut::<LANES>();
+        let (length_sq, _) = length_sqs.as_chunks::<LANES>();
         let (stiffness, _) = self.stiffness.as_chunks::<LANES>();
         let (rest, _) = self.rest.as_chunks::<LANES>();
         for (((t, l2), k), l0) in tension.iter_mut().zip(length_sq).zip(stiffness).zip(rest) {
@@ -110,7 +124,7 @@ impl SpringForces {
                 energy[i] += 0.5 * force[i] * stretch[i];
             }
         }
-        for (g, t) in self.g.chunks_exact_mut(D).zip(&self.tension) {
+        for (g, t) in gs.chunks_exact_mut(D).zip(tensions.iter()) {
             for gi in g {
                 *gi *= t;
             }
@@ -119,7 +133,7 @@ impl SpringForces {
         let sum = |springs: &[u32]| -> [f64; D] {
             let mut acc = [0.0; D];
             for &s in springs {
-                let g = &self.g[s as usize * D..s as usize * D + D];
+                let g = &gs[s as usize * D..s as usize * D + D];
                 for i in 0..D {
                     acc[i] += g[i];
                 }
@@ -344,4 +358,13 @@ pub fn omega_sq_bound_full(scene: &Scene) -> f64 {
         }
     }
     row.into_iter().fold(0.0, f64::max)
+}
+
+/// The linearization at rest: the sparsity of the free-DOF stiffness and the
+/// upper triangle of K0 = K(x*) on it.
+pub fn linearize(scene: &Scene) -> (StiffnessPattern, Vec<f64>) {
+    let pattern = StiffnessPattern::new(scene);
+    let mut k0 = vec![0.0; pattern.nnz()];
+    pattern.add_tangent(scene, &scene.rest, 1.0, &mut k0);
+    (pattern, k0)
 }

@@ -1,18 +1,37 @@
-//! Physics core: scenes, assembly, eigen decomposition and the modal and
-//! full-space Newmark integrators. Knows nothing of FMI.
+//! Physics core: the mass-spring model, its modal reduction and the time
+//! integrators of `docs/method.md`. Knows nothing of FMI.
 //!
-//! Pipeline of one modal force evaluation: `expand` (q -> x) ->
-//! `SpringForces` (exact spring forces in physical space, paper eq. 1)
-//! -> `project` (F = Phi^T f) -> Newmark update in the reduced space.
+//! - [`scene`]: what the solver simulates (slots, springs, masses); [`grid`]
+//!   builds the canonical scenes, nothing else knows there is a grid;
+//! - [`forces`]: exact spring forces, tangent stiffness, sparsity;
+//! - [`modes`]: the generalized eigen decomposition K phi = lambda M phi;
+//! - [`space`]: where the equations M y'' + C y' = h(y) live (modal, full),
+//!   each a constant model with its own scratch;
+//! - [`integrator`]: the schemes (explicit and implicit Newmark), written
+//!   once against [`space::Space`];
+//! - [`engine`]: a space and a scheme bound together;
+//! - [`state`]: [`State`] and [`Loads`], what changes while running;
+//! - [`simulator`]: set-up, sub-stepping, divergence checks, outputs;
+//! - [`error`]: typed errors that name the quantity and the limit.
+//!
+//! One modal force evaluation is the pipeline `expand` (q -> x) -> exact
+//! spring forces in physical space -> `project` (Phi^T f).
 
+pub mod engine;
+pub mod error;
 pub mod forces;
-pub mod full;
-pub mod modal;
+pub mod grid;
+pub mod integrator;
 pub mod modes;
-pub mod newmark;
-mod params;
 pub mod scene;
-mod simulator;
+pub mod simulator;
+pub mod space;
+pub mod state;
 
-pub use params::*;
-pub use simulator::{SimError, Simulator, Snapshot, EXPLICIT_SAFETY, MAX_INTERNAL_STEPS_PER_CALL};
+pub use error::{PhysicsError, Quantity, StepFailure};
+pub use grid::{FixedNodes, Grid};
+pub use integrator::{Integrator, EXPLICIT_SAFETY};
+pub use scene::Scene;
+pub use simulator::{internal_step_count, Simulator, SolverParams, MAX_INTERNAL_STEPS_PER_CALL, STEP_COUNT_TOLERANCE};
+pub use space::Reduction;
+pub use state::{Loads, Snapshot, State};

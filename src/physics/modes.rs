@@ -17,9 +17,9 @@ use faer::matrix_free::LinOp;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Col, Mat, MatMut, MatRef, Par, Side};
 
+use super::error::PhysicsError;
 use super::forces::StiffnessPattern;
 use super::scene::Scene;
-use super::SimError;
 
 /// Largest dense eigenproblem attempted (free DOFs): its matrix alone takes
 /// n^2 * 8 bytes, 512 MB at this size, and O(n^3) work.
@@ -50,18 +50,16 @@ pub struct ModalBasis {
 impl ModalBasis {
     /// The `r` lowest modes of the stiffness whose upper triangle is `k_vals`
     /// on `pattern`, with the diagonal masses of `scene`.
-    pub fn lowest(scene: &Scene, pattern: &StiffnessPattern, k_vals: &[f64], r: usize) -> Result<Self, SimError> {
+    pub fn lowest(scene: &Scene, pattern: &StiffnessPattern, k_vals: &[f64], r: usize) -> Result<Self, PhysicsError> {
         let n = scene.n_dofs();
         if r > n {
-            return Err(SimError { message: format!("nModes = {r} exceeds the {n} free degrees of freedom of the scene") });
+            return Err(PhysicsError::ModesExceedDofs { modes: r, dofs: n });
         }
         if n > PARTIAL_MIN_DOFS && r * PARTIAL_MAX_FRACTION <= n {
             match Self::partial(scene, pattern, k_vals, r) {
                 Ok(basis) => Ok(basis),
                 // Where the dense solver can run, it settles what the partial one cannot.
-                Err(e) if n <= MAX_DENSE_DOFS => {
-                    Self::dense(scene, pattern, k_vals, r).map_err(|d| SimError { message: format!("{}; {}", e.message, d.message) })
-                }
+                Err(_) if n <= MAX_DENSE_DOFS => Self::dense(scene, pattern, k_vals, r),
                 Err(e) => Err(e),
             }
         } else {
@@ -70,16 +68,10 @@ impl ModalBasis {
     }
 
     /// All eigenpairs of K~ by faer's dense self-adjoint eigensolver; keeps the lowest `r`.
-    pub fn dense(scene: &Scene, pattern: &StiffnessPattern, k_vals: &[f64], r: usize) -> Result<Self, SimError> {
+    pub fn dense(scene: &Scene, pattern: &StiffnessPattern, k_vals: &[f64], r: usize) -> Result<Self, PhysicsError> {
         let n = scene.n_dofs();
         if n > MAX_DENSE_DOFS {
-            return Err(SimError {
-                message: format!(
-                    "nModes = {r} needs a dense eigen decomposition of the {n} free DOFs, above the limit of \
-                     {MAX_DENSE_DOFS}; keep at most {} modes (solved by the partial eigensolver), or use reduction = full",
-                    n / PARTIAL_MAX_FRACTION
-                ),
-            });
+            return Err(PhysicsError::DenseEigenTooLarge { modes: r, dofs: n, limit: MAX_DENSE_DOFS, partial_max: n / PARTIAL_MAX_FRACTION });
         }
         let inv_sqrt_m: Vec<f64> = scene.dof_mass.iter().map(|m| 1.0 / m.sqrt()).collect();
         let mut kt = Mat::<f64>::zeros(n, n);
@@ -91,7 +83,9 @@ impl ModalBasis {
                 kt[(c, row)] = v;
             }
         }
-        let evd = kt.self_adjoint_eigen(Side::Lower).map_err(|e| SimError { message: format!("eigen decomposition of the stiffness matrix failed: {e:?}") })?;
+        let evd = kt
+            .self_adjoint_eigen(Side::Lower)
+            .map_err(|e| PhysicsError::LinearAlgebra { what: "eigen decomposition of the stiffness matrix", detail: format!("{e:?}") })?;
         let s = evd.S();
         let lambda_max = if n > 0 { s[n - 1].abs() } else { 0.0 };
         Self::from_pairs(n, r, (0..r).map(|j| s[j]), lambda_max, evd.U(), &inv_sqrt_m)
@@ -108,7 +102,7 @@ impl ModalBasis {
     /// not be the r lowest. Uncoupled DOFs (the source of the large clusters)
     /// are split off exactly; a result that still holds a repeated
     /// eigenvalue is refused.
-    pub fn partial(scene: &Scene, pattern: &StiffnessPattern, k_vals: &[f64], r: usize) -> Result<Self, SimError> {
+    pub fn partial(scene: &Scene, pattern: &StiffnessPattern, k_vals: &[f64], r: usize) -> Result<Self, PhysicsError> {
         let n = scene.n_dofs();
         let mass = &scene.dof_mass;
         let diag_max = pattern.diag.iter().enumerate().fold(0.0f64, |m, (k, &pos)| m.max(k_vals[pos] / mass[k]));
@@ -128,12 +122,7 @@ impl ModalBasis {
         }
         let block: Vec<usize> = (0..n).filter(|&k| coupled[k]).collect();
         if r.min(block.len()) * PARTIAL_MAX_FRACTION > block.len() {
-            return Err(SimError {
-                message: format!(
-                    "nModes = {r} is too many for the partial eigensolver on {} coupled DOFs (at most 1/{PARTIAL_MAX_FRACTION} of them)",
-                    block.len()
-                ),
-            });
+            return Err(PhysicsError::PartialTooManyModes { modes: r, coupled: block.len(), fraction: PARTIAL_MAX_FRACTION });
         }
         let (block_lambda, block_vectors) = coupled_block_lowest(pattern, k_vals, mass, &block, r.min(block.len()), diag_max)?;
         // Merge with the isolated DOFs, lowest first (ties: block modes, then DOF order).
@@ -158,7 +147,14 @@ impl ModalBasis {
 
     /// Basis from the eigenpairs of K~ (ascending values, orthonormal vectors
     /// as columns of `u`).
-    fn from_pairs(n: usize, r: usize, values: impl Iterator<Item = f64>, lambda_max: f64, u: MatRef<'_, f64>, inv_sqrt_m: &[f64]) -> Result<Self, SimError> {
+    fn from_pairs(
+        n: usize,
+        r: usize,
+        values: impl Iterator<Item = f64>,
+        lambda_max: f64,
+        u: MatRef<'_, f64>,
+        inv_sqrt_m: &[f64],
+    ) -> Result<Self, PhysicsError> {
         let lambda = values
             .map(|l| {
                 // Round-off around a zero eigenvalue (mechanism, rigid mode) may come out slightly negative.
@@ -170,7 +166,7 @@ impl ModalBasis {
             })
             .collect::<Vec<_>>();
         if let Some(&l) = lambda.iter().find(|l| !(**l >= 0.0)) {
-            return Err(SimError { message: format!("stiffness matrix at rest has a negative eigenvalue {l}") });
+            return Err(PhysicsError::NegativeEigenvalue { lambda: l });
         }
         let mut phi = vec![0.0; n * r];
         for i in 0..n {
@@ -209,7 +205,7 @@ fn coupled_block_lowest(
     block: &[usize],
     r: usize,
     diag_max: f64,
-) -> Result<(Vec<f64>, Mat<f64>), SimError> {
+) -> Result<(Vec<f64>, Mat<f64>), PhysicsError> {
     let nb = block.len();
     if r == 0 {
         return Ok((Vec::new(), Mat::zeros(nb, 0)));
@@ -235,7 +231,7 @@ fn coupled_block_lowest(
     let sym = SymbolicSparseColMatRef::new_checked(nb, nb, &col_ptr, None, &row_idx);
     let llt = SparseColMatRef::new(sym, &vals)
         .sp_cholesky(Side::Upper)
-        .map_err(|e| SimError { message: format!("the stiffness matrix at rest is not positive semi-definite (sparse Cholesky: {e:?})") })?;
+        .map_err(|e| PhysicsError::LinearAlgebra { what: "sparse Cholesky factorization of the shifted stiffness", detail: format!("{e:?}") })?;
     let mut op = ShiftInvert { llt, sqrt_m: block.iter().map(|&k| mass[k].sqrt()).collect(), scale: 1.0 };
     // Scale A so its largest eigenvalue is near 1 and the absolute residual
     // tolerance of the Krylov-Schur solver is a relative one: a few inverse
@@ -258,12 +254,7 @@ fn coupled_block_lowest(
     let mut mem = MemBuffer::new(partial_self_adjoint_eigen_scratch::<f64>(&op, r, Par::Seq, params));
     let info = partial_self_adjoint_eigen(vectors.as_mut(), &mut values, &op, v0.as_ref(), 1e-12, Par::Seq, MemStack::new(&mut mem), params);
     if info.n_converged_eigen < r {
-        return Err(SimError {
-            message: format!(
-                "the partial eigensolver found {} of the nModes = {r} lowest modes; keep fewer modes or use reduction = full",
-                info.n_converged_eigen
-            ),
-        });
+        return Err(PhysicsError::PartialIncomplete { found: info.n_converged_eigen, modes: r });
     }
     // Ascending lambda = sigma + 1 / mu, with mu unscaled.
     let lambda_of = |j: usize| sigma + op.scale / values[j];
@@ -271,13 +262,7 @@ fn coupled_block_lowest(
     order.sort_by(|&a, &b| lambda_of(a).total_cmp(&lambda_of(b)));
     let lambda: Vec<f64> = order.iter().map(|&j| lambda_of(j)).collect();
     if let Some(w) = lambda.windows(2).find(|w| (w[1] - w[0]).abs() <= 1e-8 * w[1].abs().max(1e-12 * diag_max)) {
-        return Err(SimError {
-            message: format!(
-                "the lowest nModes = {r} modes reach a repeated eigenvalue ({:.6e} 1/s^2), whose copies the partial \
-                 eigensolver cannot all find; keep fewer modes (below the repeated one)",
-                w[0]
-            ),
-        });
+        return Err(PhysicsError::RepeatedEigenvalue { modes: r, lambda: w[0] });
     }
     Ok((lambda, Mat::<f64>::from_fn(nb, r, |i, j| vectors[(i, order[j])])))
 }

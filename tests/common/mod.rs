@@ -12,8 +12,8 @@ use std::time::SystemTime;
 
 use fmi_sys::fmi3::*;
 use modal_mass_spring::fmi::exports::*;
-use modal_mass_spring::fmi::instance::Mode;
 use modal_mass_spring::fmi::serialize;
+use modal_mass_spring::fmi::state_machine::Mode;
 use modal_mass_spring::fmi::variables::{vr, INSTANTIATION_TOKEN};
 
 pub const OK: fmi3Status = fmi3Status_fmi3OK;

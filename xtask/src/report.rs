@@ -48,7 +48,7 @@ pub fn run(quick: bool, out: &str, cargo_args: &[&str]) -> Result<(), String> {
     }
     let status = Command::new(python)
         .current_dir(&root)
-        .args(["xtask/plot_report.py", &format!("{out}/error_vs_runtime.csv"), &out])
+        .args(["xtask/plot_report.py", &format!("{out}/error_vs_runtime.csv"), out])
         .status()
         .map_err(|e| format!("cannot run python: {e}"))?;
     if !status.success() {

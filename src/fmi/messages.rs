@@ -1,0 +1,98 @@
+//! Physics errors as messages that name the FMU's variables: the one place
+//! where the quantities of the core meet the names of the model description.
+
+use super::model::Params;
+use super::variables::vr;
+use crate::options::{Integrator, Reduction};
+use crate::physics::{PhysicsError, Quantity, StepFailure};
+
+/// The variable that sets `q`.
+pub fn variable(q: Quantity) -> &'static str {
+    match q {
+        Quantity::Dimension => "dimension",
+        Quantity::Columns => "nx",
+        Quantity::Rows => "ny",
+        Quantity::Spacing => "spacing",
+        Quantity::NodeMass => "nodeMass",
+        Quantity::SpringStiffness => "springStiffness",
+        Quantity::AuxStiffness => "auxStiffness",
+        Quantity::MaxInternalStep => "maxInternalStep",
+        Quantity::Modes => "nModes",
+        Quantity::Gravity => "gravity",
+        Quantity::DampingAlpha => "dampingAlpha",
+        Quantity::DampingBeta => "dampingBeta",
+        Quantity::ModeWeights => "modeWeights",
+        Quantity::StepSize => "communicationStepSize",
+    }
+}
+
+/// `e` in the words of the model description, for an instance with values `p`.
+pub fn describe(e: &PhysicsError, p: &Params) -> String {
+    use PhysicsError::*;
+    let integrator = |i: Integrator| format!("integrator = {}", i.name());
+    match e {
+        Invalid { quantity, value, expected } => format!("{} must be {expected}, got {value}", variable(*quantity)),
+        Length { quantity, len, expected } => format!("{} has {len} values, nModes is {expected}", variable(*quantity)),
+        TooManyNodes { nodes, limit } => format!("nx * ny = {nodes} exceeds the limit of {limit} nodes"),
+        NoFreeNode => format!(
+            "ny = {} (nx = {}) leaves no free node under fixedNodes: the scene has no free degree of freedom; \
+             it needs ny >= 2 (or nx >= 3 with top-corners)",
+            p.scalar(vr::NY),
+            p.scalar(vr::NX)
+        ),
+        ModesExceedDofs { modes, dofs } => format!("nModes = {modes} exceeds the {dofs} free degrees of freedom of the scene"),
+        DenseEigenTooLarge { modes, dofs, limit, partial_max } => format!(
+            "nModes = {modes} needs a dense eigen decomposition of the {dofs} free DOFs, above the limit of {limit}; \
+             keep at most {partial_max} modes (solved by the partial eigensolver), or use reduction = {}",
+            Reduction::Full.name()
+        ),
+        PartialTooManyModes { modes, coupled, fraction } => {
+            format!("nModes = {modes} is too many for the partial eigensolver on {coupled} coupled DOFs (at most 1/{fraction} of them)")
+        }
+        PartialIncomplete { found, modes } => {
+            format!(
+                "the partial eigensolver found {found} of the nModes = {modes} lowest modes; keep fewer modes or use reduction = {}",
+                Reduction::Full.name()
+            )
+        }
+        RepeatedEigenvalue { modes, lambda } => format!(
+            "the lowest nModes = {modes} modes reach a repeated eigenvalue ({lambda:.6e} 1/s^2), whose copies the partial \
+             eigensolver cannot all find; keep fewer modes (below the repeated one)"
+        ),
+        NegativeEigenvalue { lambda } => format!("the stiffness matrix at rest has a negative eigenvalue {lambda}"),
+        LinearAlgebra { .. } => e.to_string(),
+        ExplicitTooStiff { stable_step, omega_max, stiffness_per_mass, per_step, max_internal_step, limit, modes } => {
+            let kept = match modes {
+                Some(r) => format!("the {r} kept modes"),
+                None => "full space".to_string(),
+            };
+            format!(
+                "{} is stable here only with internal steps of {stable_step:.3e} s \
+                 (highest frequency {omega_max:.3e} rad/s of {kept}, springStiffness / nodeMass = {stiffness_per_mass:.3e} 1/s^2), \
+                 {per_step:.2e} of them per maxInternalStep = {max_internal_step} s (limit {limit:e}): \
+                 use {}, fewer modes (nModes), or set maxInternalStep to {:.3e} s or less to accept steps that short",
+                integrator(Integrator::NewmarkExplicit),
+                integrator(Integrator::NewmarkImplicit),
+                stable_step * limit,
+            )
+        }
+        TooManyInternalSteps { h, steps, dt, limit } => format!(
+            "a step of {h:e} s needs {steps:e} internal steps of at most {dt:e} s (limit {limit}); \
+             use {}, fewer modes (nModes) or a shorter communication step",
+            integrator(Integrator::NewmarkImplicit)
+        ),
+        StepFailed { time, cause } => format!("step from t = {time} s failed: {}", failure(cause)),
+        SnapshotLength { len, expected } => format!("the state holds {len} values per array, this scene needs {expected}"),
+        SnapshotNotFinite => "the state holds non-finite values".into(),
+    }
+}
+
+fn failure(cause: &StepFailure) -> String {
+    match cause {
+        StepFailure::NonFinite { .. } | StepFailure::EnergyGrowth { .. } | StepFailure::SingularNewton { .. } => cause.to_string(),
+        StepFailure::NewtonNotConverged { iterations, dt } => {
+            format!("implicit Newmark: Newton did not converge in {iterations} iterations at dt = {dt:e} s; reduce maxInternalStep")
+        }
+        StepFailure::Buckled => "the full-space Newmark matrix is singular (springs in compression buckle); reduce maxInternalStep".into(),
+    }
+}

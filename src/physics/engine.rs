@@ -1,0 +1,162 @@
+//! A space and a scheme bound together with their scratch: the one place
+//! where the two meet. [`Engine`] is generic, so a step calls the space
+//! without indirection; the simulator holds it behind the object-safe
+//! [`Stepper`], chosen once at set-up by the registries
+//! ([`super::space::build`], [`super::integrator::bind`]).
+
+use std::marker::PhantomData;
+
+use super::error::StepFailure;
+use super::integrator::{Buffers, Scheme};
+use super::scene::Scene;
+use super::space::Space;
+use super::state::{Loads, State};
+
+/// What the simulator asks of a bound space and scheme.
+pub trait Stepper: Send {
+    fn scene(&self) -> &Scene;
+    /// Number of generalized coordinates.
+    fn coordinates(&self) -> usize;
+    /// Modes kept (`None` in full space).
+    fn kept_modes(&self) -> Option<usize>;
+    /// Frequencies of the kept or reported modes [rad/s].
+    fn frequencies(&self) -> &[f64];
+    /// Longest stable internal step under `loads`, if stability limits it.
+    fn stable_step(&self, loads: &Loads) -> Option<f64>;
+    /// Squared-frequency bound of the integrated system under `loads` [1/s^2].
+    fn omega_sq_bound(&self, loads: &Loads) -> f64;
+    /// Derives the load terms of the space from `loads`.
+    fn apply_loads(&mut self, loads: &Loads);
+    /// Evaluates the forces at `state.y` (positions and elastic energy
+    /// follow it) and sets `state.a` from them: at the start, and after a
+    /// change of loads, which then acts as a step input.
+    fn settle(&mut self, loads: &Loads, state: &mut State);
+    /// Evaluates the forces at `state.y` only (after a restore, which
+    /// brings its own accelerations).
+    fn evaluate(&mut self, loads: &Loads, state: &State);
+    /// One internal step of length `dt`.
+    fn step(&mut self, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure>;
+    /// Kinetic energy of `state` [J].
+    fn kinetic_energy(&self, state: &State) -> f64;
+    /// The outputs of `state` (whose forces were evaluated last).
+    fn outputs(&self, loads: &Loads, state: &State, out: &mut Outputs);
+}
+
+/// Everything a simulator reports after a step.
+#[derive(Clone, Debug)]
+pub struct Outputs {
+    /// Node positions in output order, `dim` per node, held nodes included [m].
+    pub positions: Vec<f64>,
+    /// Node velocities, same layout [m/s].
+    pub velocities: Vec<f64>,
+    /// Velocities of the free DOFs.
+    pub dof_velocities: Vec<f64>,
+    /// Coordinates of the kept or reported modes.
+    pub modal_coordinates: Vec<f64>,
+    /// 1/2 v^T M v [J].
+    pub kinetic: f64,
+    /// Elastic energy plus gravity potential relative to rest [J].
+    pub potential: f64,
+}
+
+impl Outputs {
+    pub fn new(scene: &Scene, modes: usize) -> Self {
+        let nodes = scene.n_nodes * scene.dim;
+        Outputs {
+            positions: vec![0.0; nodes],
+            velocities: vec![0.0; nodes],
+            dof_velocities: vec![0.0; scene.n_dofs()],
+            modal_coordinates: vec![0.0; modes],
+            kinetic: 0.0,
+            potential: 0.0,
+        }
+    }
+}
+
+/// Space `S` integrated by scheme `I`.
+pub struct Engine<S: Space, I: Scheme> {
+    space: S,
+    work: S::Work,
+    buffers: Buffers,
+    scheme: PhantomData<I>,
+}
+
+impl<S: Space, I: Scheme> Engine<S, I> {
+    pub fn new(space: S) -> Self {
+        Engine { work: space.work(), buffers: Buffers::new(space.coordinates()), space, scheme: PhantomData }
+    }
+}
+
+impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
+    fn scene(&self) -> &Scene {
+        self.space.scene()
+    }
+
+    fn coordinates(&self) -> usize {
+        self.space.coordinates()
+    }
+
+    fn kept_modes(&self) -> Option<usize> {
+        self.space.kept_modes()
+    }
+
+    fn frequencies(&self) -> &[f64] {
+        self.space.frequencies()
+    }
+
+    fn stable_step(&self, loads: &Loads) -> Option<f64> {
+        I::stable_step(self.space.omega_sq_bound(loads))
+    }
+
+    fn omega_sq_bound(&self, loads: &Loads) -> f64 {
+        self.space.omega_sq_bound(loads)
+    }
+
+    fn apply_loads(&mut self, loads: &Loads) {
+        self.space.apply_loads(loads, &mut self.work);
+    }
+
+    fn settle(&mut self, loads: &Loads, state: &mut State) {
+        self.space.force(loads, &state.y, &mut self.work, &mut self.buffers.h);
+        self.space.acceleration(&state.v, &self.buffers.h, &mut self.work, &mut state.a);
+    }
+
+    fn evaluate(&mut self, loads: &Loads, state: &State) {
+        self.space.force(loads, &state.y, &mut self.work, &mut self.buffers.h);
+    }
+
+    fn step(&mut self, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure> {
+        I::step(&self.space, &mut self.work, &mut self.buffers, loads, state, dt)
+    }
+
+    fn kinetic_energy(&self, state: &State) -> f64 {
+        self.space.kinetic_energy(&state.v)
+    }
+
+    fn outputs(&self, loads: &Loads, state: &State, out: &mut Outputs) {
+        let space = &self.space;
+        let scene = space.scene();
+        out.kinetic = space.kinetic_energy(&state.v);
+        space.dof_velocities(&state.v, &mut out.dof_velocities);
+        space.modal_coordinates(&state.y, &mut out.modal_coordinates);
+        let x = space.positions(&self.work);
+        match scene.dim {
+            2 => to_node_order::<2>(&scene.slot_of_node, scene.n_free, x, &out.dof_velocities, &mut out.positions, &mut out.velocities),
+            _ => to_node_order::<3>(&scene.slot_of_node, scene.n_free, x, &out.dof_velocities, &mut out.positions, &mut out.velocities),
+        }
+        out.potential = space.elastic_energy(&self.work) + space.gravity_potential(loads, &state.y, &self.work);
+    }
+}
+
+/// Slot-ordered positions and free-DOF velocities into node order. Fixed
+/// length `D` keeps each copy a pair of moves instead of a `memmove` call.
+fn to_node_order<const D: usize>(slot_of_node: &[usize], n_free: usize, x: &[f64], v: &[f64], positions: &mut [f64], velocities: &mut [f64]) {
+    for ((&slot, p), vel) in slot_of_node.iter().zip(positions.chunks_exact_mut(D)).zip(velocities.chunks_exact_mut(D)) {
+        let xs: &[f64; D] = x[slot * D..slot * D + D].try_into().expect("D values");
+        *<&mut [f64; D]>::try_from(p).expect("D values") = *xs;
+        if slot < n_free {
+            let vs: &[f64; D] = v[slot * D..slot * D + D].try_into().expect("D values");
+            *<&mut [f64; D]>::try_from(vel).expect("D values") = *vs;
+        }
+    }
+}

@@ -1,0 +1,249 @@
+//! Typed errors of the physics core.
+//!
+//! Each error says which quantity is at fault, which limit it passed and,
+//! where there is one, what would lift it, in the terms of the physics
+//! (`docs/method.md`). The FMI layer (`crate::fmi::messages`) turns them
+//! into messages that name its variables; [`std::fmt::Display`] here is for
+//! users of the core alone (tests, benchmarks, the study).
+
+use std::fmt;
+
+/// A quantity of the scene, the solver, the loads or a step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quantity {
+    /// Space dimension d.
+    Dimension,
+    /// Nodes per grid row.
+    Columns,
+    /// Grid rows.
+    Rows,
+    /// Rest distance between grid neighbours [m].
+    Spacing,
+    /// Lumped node mass [kg].
+    NodeMass,
+    /// Stiffness of the grid springs [N/m].
+    SpringStiffness,
+    /// Stiffness of the auxiliary out-of-plane springs [N/m].
+    AuxStiffness,
+    /// Upper bound on one internal step [s].
+    MaxInternalStep,
+    /// Number of modes kept or reported.
+    Modes,
+    /// Gravitational acceleration [m/s^2].
+    Gravity,
+    /// Mass-proportional Rayleigh damping alpha [1/s].
+    DampingAlpha,
+    /// Stiffness-proportional Rayleigh damping beta [s].
+    DampingBeta,
+    /// Gains of the kept modes.
+    ModeWeights,
+    /// Length of a communication step [s].
+    StepSize,
+}
+
+impl Quantity {
+    /// Its name in the words of `docs/method.md`.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Quantity::Dimension => "space dimension",
+            Quantity::Columns => "nodes per row",
+            Quantity::Rows => "rows",
+            Quantity::Spacing => "node spacing",
+            Quantity::NodeMass => "node mass",
+            Quantity::SpringStiffness => "spring stiffness",
+            Quantity::AuxStiffness => "auxiliary spring stiffness",
+            Quantity::MaxInternalStep => "internal step bound",
+            Quantity::Modes => "number of modes",
+            Quantity::Gravity => "gravity",
+            Quantity::DampingAlpha => "mass-proportional damping",
+            Quantity::DampingBeta => "stiffness-proportional damping",
+            Quantity::ModeWeights => "mode weights",
+            Quantity::StepSize => "communication step",
+        }
+    }
+}
+
+/// What a refused value had to be.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Expected {
+    /// Finite and > 0.
+    Positive,
+    /// Finite and >= 0.
+    NonNegative,
+    /// Finite.
+    Finite,
+    /// 2 or 3.
+    TwoOrThree,
+    /// At least this value.
+    AtLeast(f64),
+}
+
+impl fmt::Display for Expected {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Expected::Positive => f.write_str("finite and positive"),
+            Expected::NonNegative => f.write_str("finite and non-negative"),
+            Expected::Finite => f.write_str("finite"),
+            Expected::TwoOrThree => f.write_str("2 or 3"),
+            Expected::AtLeast(x) => write!(f, "at least {x}"),
+        }
+    }
+}
+
+/// Why an internal step failed. The state is that of the start of the
+/// communication step whenever one of these is returned.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StepFailure {
+    /// A coordinate or rate became NaN or infinite.
+    NonFinite { dt: f64 },
+    /// Kinetic energy grew beyond what the loads could supply in one step.
+    EnergyGrowth { kinetic: f64, before: f64, dt: f64 },
+    /// The Newton iteration of an implicit step did not converge.
+    NewtonNotConverged { iterations: usize, dt: f64 },
+    /// The Newton matrix of an implicit step is singular.
+    SingularNewton { dt: f64 },
+    /// The full-space Newton matrix is singular even as LDL^T (springs in
+    /// compression buckle).
+    Buckled,
+}
+
+/// An error of the physics core.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PhysicsError {
+    /// A quantity outside what the solver can run.
+    Invalid { quantity: Quantity, value: f64, expected: Expected },
+    /// An array of the wrong length.
+    Length { quantity: Quantity, len: usize, expected: usize },
+    /// More nodes than the arrays can hold.
+    TooManyNodes { nodes: f64, limit: usize },
+    /// No node is free to move.
+    NoFreeNode,
+    /// More modes asked for than there are free degrees of freedom.
+    ModesExceedDofs { modes: usize, dofs: usize },
+    /// A dense eigen decomposition beyond its size limit.
+    DenseEigenTooLarge { modes: usize, dofs: usize, limit: usize, partial_max: usize },
+    /// More modes than the partial eigensolver can find reliably.
+    PartialTooManyModes { modes: usize, coupled: usize, fraction: usize },
+    /// The partial eigensolver found fewer modes than asked for.
+    PartialIncomplete { found: usize, modes: usize },
+    /// The modes asked for reach a repeated eigenvalue the partial solver
+    /// cannot resolve.
+    RepeatedEigenvalue { modes: usize, lambda: f64 },
+    /// The stiffness at the linearization point is not positive semi-definite.
+    NegativeEigenvalue { lambda: f64 },
+    /// A factorization or eigen decomposition failed.
+    LinearAlgebra { what: &'static str, detail: String },
+    /// The explicit integrator would need more than `limit` internal steps
+    /// per internal step bound: the scene is too stiff for it.
+    ExplicitTooStiff {
+        /// Largest stable internal step [s].
+        stable_step: f64,
+        /// Highest frequency of the integrated system [rad/s].
+        omega_max: f64,
+        /// Stiffest spring over the lightest node [1/s^2].
+        stiffness_per_mass: f64,
+        /// Internal steps per bound.
+        per_step: f64,
+        max_internal_step: f64,
+        limit: f64,
+        /// Modes kept, or `None` in full space.
+        modes: Option<usize>,
+    },
+    /// A communication step that would need more internal steps than one call may take.
+    TooManyInternalSteps { h: f64, steps: f64, dt: f64, limit: usize },
+    /// A communication step failed; the state is that of its start.
+    StepFailed { time: f64, cause: StepFailure },
+    /// A snapshot whose arrays do not fit this simulator.
+    SnapshotLength { len: usize, expected: usize },
+    /// A snapshot holding NaN or infinite values.
+    SnapshotNotFinite,
+}
+
+impl fmt::Display for StepFailure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            StepFailure::NonFinite { dt } => write!(f, "the state became non-finite (internal step {dt:e} s); the integration diverged"),
+            StepFailure::EnergyGrowth { kinetic, before, dt } => {
+                write!(f, "kinetic energy grew to {kinetic:e} J from {before:e} J in one step (internal step {dt:e} s); the integration diverged")
+            }
+            StepFailure::NewtonNotConverged { iterations, dt } => {
+                write!(f, "implicit Newmark: Newton did not converge in {iterations} iterations at dt = {dt:e} s; shorten the internal steps")
+            }
+            StepFailure::SingularNewton { dt } => write!(f, "implicit Newmark: singular Newton matrix at dt = {dt:e} s"),
+            StepFailure::Buckled => f.write_str("the full-space Newmark matrix is singular (springs in compression buckle); shorten the internal steps"),
+        }
+    }
+}
+
+impl fmt::Display for PhysicsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        use PhysicsError::*;
+        match self {
+            Invalid { quantity, value, expected } => write!(f, "{} must be {expected}, got {value}", quantity.describe()),
+            Length { quantity, len, expected } => write!(f, "{} has {len} values, expected {expected}", quantity.describe()),
+            TooManyNodes { nodes, limit } => write!(f, "{nodes} nodes exceed the limit of {limit}"),
+            NoFreeNode => f.write_str("no node is free to move: the scene has no free degree of freedom"),
+            ModesExceedDofs { modes, dofs } => write!(f, "{modes} modes exceed the {dofs} free degrees of freedom of the scene"),
+            DenseEigenTooLarge { modes, dofs, limit, partial_max } => write!(
+                f,
+                "{modes} modes need a dense eigen decomposition of the {dofs} free DOFs, above the limit of {limit}; \
+                 keep at most {partial_max} modes (solved by the partial eigensolver), or integrate in full space"
+            ),
+            PartialTooManyModes { modes, coupled, fraction } => {
+                write!(f, "{modes} modes are too many for the partial eigensolver on {coupled} coupled DOFs (at most 1/{fraction} of them)")
+            }
+            PartialIncomplete { found, modes } => {
+                write!(f, "the partial eigensolver found {found} of the {modes} lowest modes; keep fewer modes or integrate in full space")
+            }
+            RepeatedEigenvalue { modes, lambda } => write!(
+                f,
+                "the lowest {modes} modes reach a repeated eigenvalue ({lambda:.6e} 1/s^2), whose copies the partial \
+                 eigensolver cannot all find; keep fewer modes (below the repeated one)"
+            ),
+            NegativeEigenvalue { lambda } => write!(f, "the stiffness at the linearization point has a negative eigenvalue {lambda}"),
+            LinearAlgebra { what, detail } => write!(f, "{what} failed: {detail}"),
+            ExplicitTooStiff { stable_step, omega_max, stiffness_per_mass, per_step, max_internal_step, limit, modes } => {
+                let kept = match modes {
+                    Some(r) => format!("the {r} kept modes"),
+                    None => "full space".into(),
+                };
+                write!(
+                    f,
+                    "explicit Newmark is stable here only with internal steps of {stable_step:.3e} s (highest frequency \
+                     {omega_max:.3e} rad/s of {kept}, stiffness / mass = {stiffness_per_mass:.3e} 1/s^2), {per_step:.2e} of them \
+                     per internal step bound of {max_internal_step} s (limit {limit:e}): use implicit Newmark, fewer modes, \
+                     or an internal step bound of {:.3e} s or less",
+                    stable_step * limit
+                )
+            }
+            TooManyInternalSteps { h, steps, dt, limit } => write!(
+                f,
+                "a step of {h:e} s needs {steps:e} internal steps of at most {dt:e} s (limit {limit}); \
+                 use the implicit integrator, fewer modes or a shorter communication step"
+            ),
+            StepFailed { time, cause } => write!(f, "step from t = {time} s failed: {cause}"),
+            SnapshotLength { len, expected } => write!(f, "the snapshot holds {len} state values, this simulator needs {expected}"),
+            SnapshotNotFinite => f.write_str("the snapshot holds non-finite values"),
+        }
+    }
+}
+
+impl std::error::Error for PhysicsError {}
+
+/// Refuses `value` unless it is finite and positive.
+pub fn positive(quantity: Quantity, value: f64) -> Result<(), PhysicsError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(PhysicsError::Invalid { quantity, value, expected: Expected::Positive })
+    }
+}
+
+/// Refuses `value` unless it is finite and non-negative.
+pub fn non_negative(quantity: Quantity, value: f64) -> Result<(), PhysicsError> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(())
+    } else {
+        Err(PhysicsError::Invalid { quantity, value, expected: Expected::NonNegative })
+    }
+}

@@ -1,0 +1,284 @@
+//! The full space: the same model on every free DOF, no reduction
+//! (`docs/method.md`, section 4), the reference of every comparison.
+//!
+//! y = u, the displacements of the free DOFs from x*, x = x* + u. M is the
+//! lumped diagonal, C = alpha M + beta K0 (Rayleigh, K0 the stiffness at x*,
+//! so the modal and full runs share one damping model). Linear systems (the
+//! implicit Newton matrix, and the explicit velocity update when beta > 0)
+//! are solved with faer's sparse Cholesky LL^T, or LDL^T where compressed
+//! springs make the Newton matrix indefinite; the symbolic analysis is made
+//! at set-up.
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LdltRef, LltRef, SymbolicCholesky, SymmetricOrdering};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, MatMut, Par, Side};
+
+use super::Space;
+use crate::physics::error::{PhysicsError, StepFailure};
+use crate::physics::forces::{linearize, omega_sq_bound_full, SpringForces, SpringScratch, StiffnessPattern};
+use crate::physics::modes::ModalBasis;
+use crate::physics::scene::Scene;
+use crate::physics::state::Loads;
+
+/// The constant model of the full-space equations.
+pub struct Full {
+    scene: Scene,
+    springs: SpringForces,
+    pattern: StiffnessPattern,
+    /// Upper triangle of K0, the stiffness at x*.
+    k0: Vec<f64>,
+    symbolic: SymbolicCholesky<usize>,
+    /// Modes whose coordinates and frequencies are reported, if any.
+    reported: Option<ModalBasis>,
+    frequencies: Vec<f64>,
+    omega_sq_bound: f64,
+    newton_scale: f64,
+}
+
+/// Load terms and scratch of a full-space run.
+pub struct FullWork {
+    alpha: f64,
+    beta: f64,
+    /// M g per DOF.
+    gravity: Vec<f64>,
+    /// Slot positions and elastic energy of the last force evaluation.
+    x: Vec<f64>,
+    elastic: f64,
+    springs: SpringScratch,
+    /// C v.
+    cv: Vec<f64>,
+    /// Values of the matrix to factor, on the stiffness pattern.
+    matrix: Vec<f64>,
+    l_values: Vec<f64>,
+    /// `l_values` holds LDL^T (the matrix was indefinite), not LL^T.
+    indefinite: bool,
+    mem: MemBuffer,
+    /// (dt, alpha, beta) for which `l_values` holds M + dt/2 C (explicit, beta > 0).
+    explicit_factor: Option<(f64, f64, f64)>,
+}
+
+impl Full {
+    /// Assembles the stiffness at rest and its symbolic Cholesky analysis;
+    /// decomposes it into the `reported_modes` lowest modes when that is not 0.
+    pub fn new(scene: Scene, reported_modes: usize) -> Result<Self, PhysicsError> {
+        let (pattern, k0) = linearize(&scene);
+        let reported = if reported_modes > 0 { Some(ModalBasis::lowest(&scene, &pattern, &k0, reported_modes)?) } else { None };
+        let n = scene.n_dofs();
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx);
+        let symbolic = factorize_symbolic_cholesky(sym, Side::Upper, SymmetricOrdering::Amd, Default::default())
+            .map_err(|e| PhysicsError::LinearAlgebra { what: "sparse Cholesky analysis", detail: format!("{e:?}") })?;
+        Ok(Full {
+            springs: SpringForces::new(&scene),
+            frequencies: reported.as_ref().map(|b| b.frequencies()).unwrap_or_default(),
+            omega_sq_bound: omega_sq_bound_full(&scene),
+            newton_scale: scene.length_scale().max(1e-300),
+            reported,
+            symbolic,
+            pattern,
+            k0,
+            scene,
+        })
+    }
+
+    /// cv = C v = alpha M v + beta K0 v.
+    fn damping_times(&self, v: &[f64], w: &mut FullWork) {
+        let mass = &self.scene.dof_mass;
+        if w.beta != 0.0 {
+            self.pattern.sym_matvec(&self.k0, v, &mut w.cv);
+            for k in 0..v.len() {
+                w.cv[k] = w.alpha * mass[k] * v[k] + w.beta * w.cv[k];
+            }
+        } else {
+            for k in 0..v.len() {
+                w.cv[k] = w.alpha * mass[k] * v[k];
+            }
+        }
+    }
+
+    /// Factorizes `c_m M + c_k K0 (+ K(x) if tangent)` into `w.l_values`.
+    fn factorize(&self, c_m: f64, c_k: f64, tangent: bool, w: &mut FullWork) -> Result<(), StepFailure> {
+        for (m, k) in w.matrix.iter_mut().zip(&self.k0) {
+            *m = c_k * k;
+        }
+        for (k, &pos) in self.pattern.diag.iter().enumerate() {
+            w.matrix[pos] += c_m * self.scene.dof_mass[k];
+        }
+        if tangent {
+            self.pattern.add_tangent(&self.scene, &w.x, 1.0, &mut w.matrix);
+        }
+        let n = self.scene.n_dofs();
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.pattern.col_ptr, None, &self.pattern.row_idx);
+        let a = SparseColMatRef::new(sym, &w.matrix);
+        let stack = MemStack::new(&mut w.mem);
+        let llt = self.symbolic.factorize_numeric_llt(&mut w.l_values, a, Side::Upper, LltRegularization::default(), Par::Seq, stack, Default::default());
+        w.indefinite = llt.is_err();
+        if !w.indefinite {
+            return Ok(());
+        }
+        // Springs in compression have negative transverse stiffness; with
+        // stiff springs it can outweigh M / (beta dt^2). Newton still
+        // converges on the indefinite matrix: factor it as LDL^T.
+        let stack = MemStack::new(&mut w.mem);
+        let regularization = LdltRegularization { dynamic_regularization_signs: None, dynamic_regularization_delta: 0.0, dynamic_regularization_epsilon: 0.0 };
+        self.symbolic
+            .factorize_numeric_ldlt(&mut w.l_values, a, Side::Upper, regularization, Par::Seq, stack, Default::default())
+            .map(|_| ())
+            .map_err(|_| StepFailure::Buckled)
+    }
+}
+
+impl Space for Full {
+    type Work = FullWork;
+
+    fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    fn coordinates(&self) -> usize {
+        self.scene.n_dofs()
+    }
+
+    fn kept_modes(&self) -> Option<usize> {
+        None
+    }
+
+    fn frequencies(&self) -> &[f64] {
+        &self.frequencies
+    }
+
+    fn work(&self) -> FullWork {
+        let n = self.scene.n_dofs();
+        let req = StackReq::any_of(&[
+            self.symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
+            self.symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
+            self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
+        ]);
+        FullWork {
+            alpha: 0.0,
+            beta: 0.0,
+            gravity: vec![0.0; n],
+            x: self.scene.rest.clone(),
+            elastic: 0.0,
+            springs: self.springs.scratch(&self.scene),
+            cv: vec![0.0; n],
+            matrix: vec![0.0; self.pattern.nnz()],
+            l_values: vec![0.0; self.symbolic.len_val()],
+            indefinite: false,
+            mem: MemBuffer::new(req),
+            explicit_factor: None,
+        }
+    }
+
+    fn apply_loads(&self, loads: &Loads, w: &mut FullWork) {
+        let d = self.scene.dim;
+        w.alpha = loads.damping_alpha;
+        w.beta = loads.damping_beta;
+        for (k, g) in w.gravity.iter_mut().enumerate() {
+            *g = self.scene.dof_mass[k] * loads.gravity[k % d];
+        }
+    }
+
+    /// h(u) = f_springs(x* + u) + M g.
+    fn force(&self, _loads: &Loads, u: &[f64], w: &mut FullWork, h: &mut [f64]) {
+        for k in 0..u.len() {
+            w.x[k] = self.scene.rest[k] + u[k];
+        }
+        h.copy_from_slice(&w.gravity);
+        w.elastic = self.springs.add_to(&self.scene, &w.x, &mut w.springs, h);
+    }
+
+    fn explicit_velocity(&self, dt: f64, v: &[f64], a: &[f64], h: &[f64], w: &mut FullWork, v1: &mut [f64]) -> Result<(), StepFailure> {
+        let mass = &self.scene.dof_mass;
+        for k in 0..v1.len() {
+            v1[k] = mass[k] * (v[k] + 0.5 * dt * a[k]) + 0.5 * dt * h[k];
+        }
+        if w.beta != 0.0 {
+            // (M + dt/2 C) is constant while dt and the damping are: factor once.
+            let key = (dt, w.alpha, w.beta);
+            if w.explicit_factor != Some(key) {
+                w.explicit_factor = None;
+                self.factorize(1.0 + 0.5 * dt * w.alpha, 0.5 * dt * w.beta, false, w)?;
+                w.explicit_factor = Some(key);
+            }
+            self.solve(w, v1);
+        } else {
+            for k in 0..v1.len() {
+                v1[k] /= mass[k] * (1.0 + 0.5 * dt * w.alpha);
+            }
+        }
+        Ok(())
+    }
+
+    fn acceleration(&self, v: &[f64], h: &[f64], w: &mut FullWork, a: &mut [f64]) {
+        self.damping_times(v, w);
+        for k in 0..a.len() {
+            a[k] = (h[k] - w.cv[k]) / self.scene.dof_mass[k];
+        }
+    }
+
+    fn residual(&self, v: &[f64], a: &[f64], h: &[f64], w: &mut FullWork, r: &mut [f64]) {
+        self.damping_times(v, w);
+        for k in 0..r.len() {
+            r[k] = -(self.scene.dof_mass[k] * a[k] + w.cv[k] - h[k]);
+        }
+    }
+
+    /// c_m M + c_c (alpha M + beta K0) + K(x): the tangent of -h is the stiffness K(x).
+    fn factor(&self, _loads: &Loads, c_m: f64, c_c: f64, w: &mut FullWork) -> Result<(), StepFailure> {
+        w.explicit_factor = None;
+        self.factorize(c_m + c_c * w.alpha, c_c * w.beta, true, w)
+    }
+
+    fn solve(&self, w: &mut FullWork, rhs: &mut [f64]) {
+        let n = rhs.len();
+        let stack = MemStack::new(&mut w.mem);
+        let rhs = MatMut::from_column_major_slice_mut(rhs, n, 1);
+        if w.indefinite {
+            LdltRef::<usize, f64>::new(&self.symbolic, &w.l_values).solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+        } else {
+            LltRef::<usize, f64>::new(&self.symbolic, &w.l_values).solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+        }
+    }
+
+    fn newton_scale(&self) -> f64 {
+        self.newton_scale
+    }
+
+    fn omega_sq_bound(&self, _loads: &Loads) -> f64 {
+        self.omega_sq_bound
+    }
+
+    fn positions<'w>(&self, w: &'w FullWork) -> &'w [f64] {
+        &w.x
+    }
+
+    fn elastic_energy(&self, w: &FullWork) -> f64 {
+        w.elastic
+    }
+
+    /// -(M g)^T u, summed node by node.
+    fn gravity_potential(&self, loads: &Loads, u: &[f64], _w: &FullWork) -> f64 {
+        let d = self.scene.dim;
+        let g = &loads.gravity;
+        let work: f64 = u.chunks_exact(d).zip(self.scene.dof_mass.chunks_exact(d)).map(|(u, m)| (0..d).map(|i| m[i] * g[i] * u[i]).sum::<f64>()).sum();
+        -work
+    }
+
+    fn kinetic_energy(&self, v: &[f64]) -> f64 {
+        0.5 * v.iter().zip(&self.scene.dof_mass).map(|(v, m)| m * v * v).sum::<f64>()
+    }
+
+    fn dof_velocities(&self, v: &[f64], out: &mut [f64]) {
+        out.copy_from_slice(v);
+    }
+
+    /// q = Phi^T M u on the reported modes.
+    fn modal_coordinates(&self, u: &[f64], out: &mut [f64]) {
+        if let Some(b) = &self.reported {
+            b.project_displacement(&self.scene.dof_mass, u, out);
+        }
+    }
+}

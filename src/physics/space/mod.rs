@@ -1,0 +1,97 @@
+//! Where the equations of motion live (`docs/method.md`, sections 3 and 4).
+//!
+//! Every space integrates
+//!
+//! ```text
+//!     M y'' + C y' = h(y)
+//! ```
+//!
+//! in its own generalized coordinates y:
+//!
+//! | space | y | M | C | h(y) |
+//! |---|---|---|---|---|
+//! | [`Modal`] | modal coordinates q, x = x* + Phi q | I | diag(alpha + beta lambda_i) | w_i (Phi^T (f(x) + M g))_i + (w_i - 1) lambda_i q_i |
+//! | [`Full`] | displacements u of the free DOFs, x = x* + u | lumped masses | alpha M + beta K0 | f(x) + M g |
+//!
+//! A space value is the constant model of its equations, fixed after
+//! set-up: the scene, the spring incidence, the basis or the sparsity and
+//! symbolic factorization. [`Space::Work`] is everything one run writes: the
+//! load terms derived from the current [`Loads`] and the scratch of force
+//! evaluations and factorizations, allocated once by [`Space::work`] so
+//! that stepping allocates nothing. The integrators
+//! ([`super::integrator`]) are written once against this trait.
+
+mod full;
+mod modal;
+
+pub use full::Full;
+pub use modal::Modal;
+
+use super::engine::Stepper;
+use super::error::{PhysicsError, StepFailure};
+use super::integrator;
+use super::scene::Scene;
+use super::simulator::SolverParams;
+use super::state::Loads;
+pub use crate::options::Reduction;
+
+/// The equations of one space; see the module documentation.
+pub trait Space: Send + Sized + 'static {
+    /// Load terms and scratch of one run.
+    type Work: Send + 'static;
+
+    /// The scene the space was built on.
+    fn scene(&self) -> &Scene;
+    /// Number of generalized coordinates.
+    fn coordinates(&self) -> usize;
+    /// Modes kept (`None` in full space, where every DOF is integrated).
+    fn kept_modes(&self) -> Option<usize>;
+    /// Angular frequencies of the kept or reported modes at the linearization point, ascending [rad/s].
+    fn frequencies(&self) -> &[f64];
+    /// Fresh load terms (all zero) and scratch.
+    fn work(&self) -> Self::Work;
+
+    /// Derives the load terms (damping per coordinate, generalized gravity) from `loads`.
+    fn apply_loads(&self, loads: &Loads, w: &mut Self::Work);
+    /// h(y) into `h`; leaves the slot positions and the elastic energy at y in `w`.
+    fn force(&self, loads: &Loads, y: &[f64], w: &mut Self::Work, h: &mut [f64]);
+    /// The velocity update of explicit Newmark: v1 from
+    /// (M + dt/2 C) v1 = M (v + dt/2 a) + dt/2 h.
+    fn explicit_velocity(&self, dt: f64, v: &[f64], a: &[f64], h: &[f64], w: &mut Self::Work, v1: &mut [f64]) -> Result<(), StepFailure>;
+    /// a from M a = h - C v.
+    fn acceleration(&self, v: &[f64], h: &[f64], w: &mut Self::Work, a: &mut [f64]);
+    /// The Newmark residual r = -(M a + C v - h).
+    fn residual(&self, v: &[f64], a: &[f64], h: &[f64], w: &mut Self::Work, r: &mut [f64]);
+    /// Factors the Newton matrix c_m M + c_c C - dh/dy at the positions of
+    /// the last [`Space::force`].
+    fn factor(&self, loads: &Loads, c_m: f64, c_c: f64, w: &mut Self::Work) -> Result<(), StepFailure>;
+    /// Solves with the last [`Space::factor`], in place.
+    fn solve(&self, w: &mut Self::Work, rhs: &mut [f64]);
+    /// Scale of y below which Newton updates count as converged.
+    fn newton_scale(&self) -> f64;
+    /// Upper bound on the squared frequencies of the integrated system
+    /// under `loads`, in any state where no spring is compressed [1/s^2].
+    fn omega_sq_bound(&self, loads: &Loads) -> f64;
+
+    /// Slot positions of the last [`Space::force`].
+    fn positions<'w>(&self, w: &'w Self::Work) -> &'w [f64];
+    /// Elastic energy of the springs at the last [`Space::force`] [J].
+    fn elastic_energy(&self, w: &Self::Work) -> f64;
+    /// Potential of gravity relative to the linearization point at y [J].
+    fn gravity_potential(&self, loads: &Loads, y: &[f64], w: &Self::Work) -> f64;
+    /// 1/2 v^T M v in physical space [J].
+    fn kinetic_energy(&self, v: &[f64]) -> f64;
+    /// Velocities of the free DOFs.
+    fn dof_velocities(&self, v: &[f64], out: &mut [f64]);
+    /// Coordinates of the kept or reported modes at y.
+    fn modal_coordinates(&self, y: &[f64], out: &mut [f64]);
+}
+
+/// The registry of spaces: builds the space `solver.reduction` names on
+/// `scene` and binds it to the integrator `solver.integrator` names.
+pub(crate) fn build(scene: Scene, solver: &SolverParams) -> Result<Box<dyn Stepper>, PhysicsError> {
+    match solver.reduction {
+        Reduction::Modal => Ok(integrator::bind(Modal::new(scene, solver.n_modes)?, solver.integrator)),
+        Reduction::Full => Ok(integrator::bind(Full::new(scene, solver.n_modes)?, solver.integrator)),
+    }
+}
