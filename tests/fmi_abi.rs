@@ -677,3 +677,24 @@ fn every_corruption_of_a_serialized_state_is_refused() {
     twin.run(5, 0.01);
     assert_eq!(f.outputs(), twin.outputs());
 }
+
+#[test]
+fn step_sizes_a_few_ulps_apart_give_the_same_trajectory() {
+    // fmusim, started at t = 1 s, steps 0.01 s as differences of
+    // communication points: 0.01000000000000001 s, one ulp above the default
+    // maxInternalStep.
+    let exact = Fmu::started();
+    let shifted = Fmu::new();
+    assert_eq!(unsafe { fmi3EnterInitializationMode(shifted.inst, false, 0.0, 1.0, false, 0.0) }, OK);
+    assert_eq!(unsafe { fmi3ExitInitializationMode(shifted.inst) }, OK);
+    for k in 0..200 {
+        let (t0, t1) = (1.0 + k as f64 * 0.01, 1.0 + (k + 1) as f64 * 0.01);
+        assert_eq!(shifted.step(t0, t1 - t0), OK, "{:?}", shifted.messages());
+        assert_eq!(exact.step(exact.time(), 0.01), OK);
+    }
+    let (a, b) = (exact.positions(), shifted.positions());
+    let diff = a.iter().zip(&b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    assert!(diff < 1e-12, "positions after 2 s differ by {diff:e} m");
+    let energy = |f: &Fmu| f.f64s(vr::KINETIC_ENERGY, 1)[0] + f.f64s(vr::POTENTIAL_ENERGY, 1)[0];
+    assert!((energy(&exact) - energy(&shifted)).abs() < 1e-12, "energies {} and {}", energy(&exact), energy(&shifted));
+}

@@ -315,3 +315,44 @@ fn a_start_value_outside_its_range_is_refused() {
     let e = generate::parse(&broken).unwrap_err();
     assert!(e.contains("spacing: start value 0 is outside its range"), "{e}");
 }
+
+/// Every Rust file under `dir`, recursively.
+fn rust_files(dir: &std::path::Path) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            out.extend(rust_files(&p));
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+    out
+}
+
+#[test]
+fn the_physics_core_names_no_fmi_variable() {
+    // The names that are the FMU's own (camelCase, or the grid's nx and ny);
+    // plain words such as "gravity" or "spacing" are the physics' too.
+    let names: Vec<&str> = VARIABLES.iter().map(|v| v.name).filter(|n| n.chars().any(|c| c.is_ascii_uppercase()) || ["nx", "ny"].contains(n)).collect();
+    assert!(names.contains(&"nModes") && names.contains(&"nx"));
+    let files = rust_files(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/physics"));
+    assert!(files.len() > 10);
+    let mut found = Vec::new();
+    for f in files {
+        let text = std::fs::read_to_string(&f).unwrap();
+        for (i, line) in text.lines().enumerate() {
+            let words: Vec<&str> = line.split(|c: char| !c.is_ascii_alphanumeric() && c != '_').collect();
+            for n in &names {
+                if words.contains(n) {
+                    found.push(format!("{}:{}: {n}", f.display(), i + 1));
+                }
+            }
+            // The FMI spelling of an option, "reduction = modal".
+            if line.contains("reduction = ") || line.contains("integrator = ") {
+                found.push(format!("{}:{}: {line}", f.display(), i + 1));
+            }
+        }
+    }
+    assert!(found.is_empty(), "FMI variable names in the physics core:\n{}", found.join("\n"));
+}

@@ -308,3 +308,49 @@ fn partial_eigensolver_matches_the_dense_one() {
         }
     }
 }
+
+/// Communication steps as masters compute them: the difference of two
+/// communication points `start + n h`, a few ulps off h (fmusim and fmpy's
+/// `simulate_fmu` both do this; fmpy's container sends h itself).
+fn master_steps(start: f64, h: f64, n: usize) -> Vec<f64> {
+    (0..n).map(|k| (start + (k + 1) as f64 * h) - (start + k as f64 * h)).collect()
+}
+
+#[test]
+fn internal_steps_do_not_depend_on_round_off_in_the_step_size() {
+    let h = 0.01;
+    // After t = 1 s, fmusim's 0.01 s steps are 0.01000000000000001 s: one ulp
+    // above maxInternalStep = 0.01 s, which split each into two steps of half the size.
+    let above = master_steps(1.0, h, 100);
+    assert!(above.iter().any(|&s| s > h && (s / h).ceil() == 2.0), "the sequence must hold steps just above maxInternalStep");
+    let below = master_steps(0.0, h, 100);
+    assert!(below.iter().any(|&s| s < h));
+    let p = scene("paper-2d-top-row");
+    for (reduction, integrator, modes) in [
+        (Reduction::Modal, Integrator::NewmarkExplicit, 2),
+        (Reduction::Modal, Integrator::NewmarkImplicit, 8),
+        (Reduction::Full, Integrator::NewmarkExplicit, 0),
+    ] {
+        let s = solver(reduction, integrator, modes);
+        let mut exact = simulator(&p, &s, &Loads::physical(modes));
+        let mut runs: Vec<Simulator> = (0..3).map(|_| simulator(&p, &s, &Loads::physical(modes))).collect();
+        let sequences = [vec![h; 100], above.clone(), master_steps(1000.0, h, 100)];
+        for k in 0..100 {
+            exact.do_step(h).unwrap();
+            for (sim, steps) in runs.iter_mut().zip(&sequences) {
+                sim.do_step(steps[k]).unwrap();
+                assert_eq!(sim.internal_steps_last(), exact.internal_steps_last(), "{reduction:?} {integrator:?}: step {k} of {}", steps[k]);
+            }
+        }
+        let scale = exact.positions().iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for (sim, steps) in runs.iter().zip(&sequences) {
+            let diff = sim.positions().iter().zip(exact.positions()).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            let dv = sim.velocities().iter().zip(exact.velocities()).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(
+                diff <= 1e-12 * scale && dv <= 1e-10,
+                "{reduction:?} {integrator:?}, steps from {}: positions {diff:e} m, velocities {dv:e} m/s apart",
+                steps[1]
+            );
+        }
+    }
+}

@@ -90,7 +90,7 @@ struct Extreme {
     steps: &'static [f64],
     /// Gravity from time t on, when it changes during the run.
     gravity: Option<fn(f64) -> [f64; 3]>,
-    /// Compare modal with full space (METHOD.md section 6) and report the stretch.
+    /// Compare modal with full space (docs/method.md, section 6) and report the stretch.
     compare: bool,
 }
 
@@ -473,7 +473,7 @@ fn run_cell(e: &Extreme, s: &SceneDef, modal: bool, implicit: bool) -> Cell {
     Cell { outcome: Outcome::Stable { drift, stretch: max_stretch }, samples, initial }
 }
 
-/// E of METHOD.md section 6 (equal node masses cancel).
+/// E of docs/method.md, section 6 (equal node masses cancel).
 fn trajectory_error(run: &[Vec<f64>], reference: &[Vec<f64>], x0: &[f64]) -> f64 {
     let mut num = 0.0;
     let mut den = 0.0;

@@ -39,7 +39,7 @@ pub trait Stepper: Send {
     /// Kinetic energy of `state` [J].
     fn kinetic_energy(&self, state: &State) -> f64;
     /// The outputs of `state` (whose forces were evaluated last).
-    fn outputs(&self, loads: &Loads, state: &State, out: &mut Outputs);
+    fn outputs(&mut self, loads: &Loads, state: &State, out: &mut Outputs);
 }
 
 /// Everything a simulator reports after a step.
@@ -133,18 +133,18 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
         self.space.kinetic_energy(&state.v)
     }
 
-    fn outputs(&self, loads: &Loads, state: &State, out: &mut Outputs) {
+    fn outputs(&mut self, loads: &Loads, state: &State, out: &mut Outputs) {
         let space = &self.space;
         let scene = space.scene();
         out.kinetic = space.kinetic_energy(&state.v);
         space.dof_velocities(&state.v, &mut out.dof_velocities);
         space.modal_coordinates(&state.y, &mut out.modal_coordinates);
-        let x = space.positions(&self.work);
+        let x = space.positions(&state.y, &mut self.work);
         match scene.dim {
             2 => to_node_order::<2>(&scene.slot_of_node, scene.n_free, x, &out.dof_velocities, &mut out.positions, &mut out.velocities),
             _ => to_node_order::<3>(&scene.slot_of_node, scene.n_free, x, &out.dof_velocities, &mut out.positions, &mut out.velocities),
         }
-        out.potential = space.elastic_energy(&self.work) + space.gravity_potential(loads, &state.y, &self.work);
+        out.potential = space.elastic_energy(&state.y, &mut self.work) + space.gravity_potential(loads, &state.y, &self.work);
     }
 }
 

@@ -42,14 +42,14 @@ impl Grid {
     /// Builds the scene, refusing parameters that cannot make one.
     pub fn build(&self) -> Result<Scene, PhysicsError> {
         self.validate()?;
-        let (nx, ny, d, h) = (self.columns, self.rows, self.dim, self.spacing);
-        let n_nodes = nx * ny;
+        let (cols, rows, d, h) = (self.columns, self.rows, self.dim, self.spacing);
+        let n_nodes = cols * rows;
         let is_fixed = |node: usize| {
-            let (row, col) = (node / nx, node % nx);
+            let (row, col) = (node / cols, node % cols);
             row == 0
                 && match self.fixed_nodes {
                     FixedNodes::TopRow => true,
-                    FixedNodes::TopCorners => col == 0 || col == nx - 1,
+                    FixedNodes::TopCorners => col == 0 || col == cols - 1,
                 }
         };
         // Free nodes first, in node order, then fixed nodes.
@@ -69,35 +69,35 @@ impl Grid {
         let mut rest = vec![0.0; n_slots * d];
         for node in 0..n_nodes {
             let s = slot_of_node[node];
-            rest[s * d] = (node % nx) as f64 * h;
-            rest[s * d + 1] = -((node / nx) as f64) * h;
+            rest[s * d] = (node % cols) as f64 * h;
+            rest[s * d + 1] = -((node / cols) as f64) * h;
         }
         let mut springs = Vec::new();
         let mut join = |r0: usize, c0: usize, r1: usize, c1: usize| {
-            let (a, b) = (slot_of_node[r0 * nx + c0], slot_of_node[r1 * nx + c1]);
+            let (a, b) = (slot_of_node[r0 * cols + c0], slot_of_node[r1 * cols + c1]);
             if a >= n_free && b >= n_free {
                 return; // both ends fixed: it never moves, never acts
             }
             let len = (0..d).map(|i| (rest[b * d + i] - rest[a * d + i]).powi(2)).sum::<f64>().sqrt();
             springs.push(Spring { a, b, k: self.spring_stiffness, rest: len });
         };
-        for r in 0..ny {
-            for c in 0..nx {
-                if c + 1 < nx {
+        for r in 0..rows {
+            for c in 0..cols {
+                if c + 1 < cols {
                     join(r, c, r, c + 1);
                 }
-                if r + 1 < ny {
+                if r + 1 < rows {
                     join(r, c, r + 1, c);
                 }
-                if self.shear_springs && r + 1 < ny && c + 1 < nx {
+                if self.shear_springs && r + 1 < rows && c + 1 < cols {
                     join(r, c, r + 1, c + 1);
                     join(r, c + 1, r + 1, c);
                 }
                 if self.bending_springs {
-                    if c + 2 < nx {
+                    if c + 2 < cols {
                         join(r, c, r, c + 2);
                     }
-                    if r + 2 < ny {
+                    if r + 2 < rows {
                         join(r, c, r + 2, c);
                     }
                 }

@@ -47,8 +47,8 @@ fn step(title: &str) {
 
 pub fn run(args: &[String]) -> Result<(), String> {
     let root = setup::root();
-    step("setup");
-    setup::main(&[])?;
+    step("setup: what building and running need");
+    setup::install(setup::Purpose::Run)?;
     step("cargo xtask fmu");
     fmu::main(&[])?;
     let fmu = fmu_dir(&root).join("ModalMassSpring.fmu");
@@ -110,7 +110,7 @@ pub fn test(args: &[String]) -> Result<(), String> {
         clock = Instant::now();
     };
     step("setup");
-    setup::main(&[])?;
+    setup::install(setup::Purpose::Test)?;
     lap("setup", &mut times);
 
     step("cargo xtask fmu (default and every canonical scene)");

@@ -1,22 +1,32 @@
-//! `cargo xtask setup`: installs what the other tasks need, and only what is
-//! missing, so it is cheap to run again.
+//! `cargo xtask setup [--for run|test]`: installs what a task needs, and
+//! only what is missing, so it is cheap to run again.
 //!
-//! - Debian packages: `libclang-dev` (bindgen in `fmi-sys`), `libxml2-dev`
-//!   (XSD validation in `fmi-rs`), `valgrind` (`cargo xtask valgrind`) and
-//!   `libclang-rt-dev` (the libFuzzer runtime `cargo xtask fuzz` links),
-//!   through apt-get (`apt-get update` once, only when something has to be
-//!   installed).
-//! - The Python environment `.venv` in the repository root, with fmpy, pytest,
-//!   numpy and matplotlib.
+//! - Debian packages, through apt-get (`apt-get update` once, only when
+//!   something has to be installed): `libclang-dev` (bindgen in `fmi-sys`)
+//!   to build the FMU; for the tests also `libxml2-dev` (XSD validation in
+//!   `fmi-rs`), `valgrind` (`cargo xtask valgrind`) and `libclang-rt-dev`
+//!   (the libFuzzer runtime `cargo xtask fuzz` links).
+//! - The Python environment `.venv` in the repository root: fmpy, numpy and
+//!   matplotlib to run the main job; pytest for the tests.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-/// Debian packages the Rust build and tests need.
-const DEBIAN_PACKAGES: &[&str] = &["libclang-dev", "libxml2-dev", "valgrind", "libclang-rt-dev"];
+/// What the installation is for.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Purpose {
+    /// Build the FMU and run the main job (`cargo xtask run`, `cargo xtask fmu`).
+    Run,
+    /// Everything `cargo xtask test` runs: also fuzzing, valgrind, the XSD check and pytest.
+    Test,
+}
 
-/// Python packages: (distribution name as pip knows it, requirement to install).
-const PYTHON_PACKAGES: &[(&str, &str)] = &[("fmpy", "fmpy==0.3.32"), ("pytest", "pytest"), ("numpy", "numpy"), ("matplotlib", "matplotlib")];
+/// Debian packages: (package, needed for the tests only).
+const DEBIAN_PACKAGES: &[(&str, bool)] = &[("libclang-dev", false), ("libxml2-dev", true), ("valgrind", true), ("libclang-rt-dev", true)];
+
+/// Python packages: (distribution name as pip knows it, requirement to install, needed for the tests only).
+const PYTHON_PACKAGES: &[(&str, &str, bool)] =
+    &[("fmpy", "fmpy==0.3.32", false), ("numpy", "numpy", false), ("matplotlib", "matplotlib", false), ("pytest", "pytest", true)];
 
 /// The version of fmpy the tests are written against.
 const FMPY_VERSION: &str = "0.3.32";
@@ -46,13 +56,25 @@ pub fn python() -> PathBuf {
 }
 
 pub fn main(args: &[String]) -> Result<(), String> {
-    if let Some(a) = args.first() {
-        return Err(format!("unknown option {a}; usage: cargo xtask setup"));
-    }
-    debian_packages()?;
+    let purpose = match args {
+        [] => Purpose::Test,
+        [f, p] if f == "--for" && p == "run" => Purpose::Run,
+        [f, p] if f == "--for" && p == "test" => Purpose::Test,
+        _ => return Err("usage: cargo xtask setup [--for run|test] (default: test, everything)".into()),
+    };
+    install(purpose)
+}
+
+/// Installs what `purpose` needs and is missing.
+pub fn install(purpose: Purpose) -> Result<(), String> {
+    debian_packages(purpose)?;
     venv()?;
-    python_packages()?;
+    python_packages(purpose)?;
     Ok(())
+}
+
+fn wanted<T: Copy>(list: &[(T, bool)], purpose: Purpose) -> Vec<T> {
+    list.iter().filter(|(_, test_only)| purpose == Purpose::Test || !test_only).map(|(x, _)| *x).collect()
 }
 
 fn debian_installed(pkg: &str) -> bool {
@@ -68,8 +90,8 @@ fn is_root() -> bool {
     Command::new("id").arg("-u").output().map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0").unwrap_or(false)
 }
 
-fn debian_packages() -> Result<(), String> {
-    let missing: Vec<&str> = DEBIAN_PACKAGES.iter().copied().filter(|p| !debian_installed(p)).collect();
+fn debian_packages(purpose: Purpose) -> Result<(), String> {
+    let missing: Vec<&str> = wanted(DEBIAN_PACKAGES, purpose).into_iter().filter(|p| !debian_installed(p)).collect();
     if missing.is_empty() {
         return Ok(());
     }
@@ -145,9 +167,12 @@ fn installed_version(dist: &str) -> Option<String> {
     (out.status.success() && !v.is_empty()).then_some(v)
 }
 
-fn python_packages() -> Result<(), String> {
+fn python_packages(purpose: Purpose) -> Result<(), String> {
     let mut missing = Vec::new();
-    for (dist, req) in PYTHON_PACKAGES {
+    for (dist, req, test_only) in PYTHON_PACKAGES {
+        if *test_only && purpose == Purpose::Run {
+            continue;
+        }
         match installed_version(dist) {
             Some(v) if *dist != "fmpy" || v == FMPY_VERSION => {}
             _ => missing.push(*req),

@@ -251,11 +251,11 @@ impl Space for Full {
         self.omega_sq_bound
     }
 
-    fn positions<'w>(&self, w: &'w FullWork) -> &'w [f64] {
+    fn positions<'w>(&self, _u: &[f64], w: &'w mut FullWork) -> &'w [f64] {
         &w.x
     }
 
-    fn elastic_energy(&self, w: &FullWork) -> f64 {
+    fn elastic_energy(&self, _u: &[f64], w: &mut FullWork) -> f64 {
         w.elastic
     }
 

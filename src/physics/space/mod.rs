@@ -25,7 +25,7 @@ mod full;
 mod modal;
 
 pub use full::Full;
-pub use modal::Modal;
+pub use modal::{Exact, Modal, Modes, ReducedForce};
 
 use super::engine::Stepper;
 use super::error::{PhysicsError, StepFailure};
@@ -73,10 +73,10 @@ pub trait Space: Send + Sized + 'static {
     /// under `loads`, in any state where no spring is compressed [1/s^2].
     fn omega_sq_bound(&self, loads: &Loads) -> f64;
 
-    /// Slot positions of the last [`Space::force`].
-    fn positions<'w>(&self, w: &'w Self::Work) -> &'w [f64];
-    /// Elastic energy of the springs at the last [`Space::force`] [J].
-    fn elastic_energy(&self, w: &Self::Work) -> f64;
+    /// Slot positions at y, the coordinates of the last [`Space::force`].
+    fn positions<'w>(&self, y: &[f64], w: &'w mut Self::Work) -> &'w [f64];
+    /// Elastic energy of the springs at y, the coordinates of the last [`Space::force`] [J].
+    fn elastic_energy(&self, y: &[f64], w: &mut Self::Work) -> f64;
     /// Potential of gravity relative to the linearization point at y [J].
     fn gravity_potential(&self, loads: &Loads, y: &[f64], w: &Self::Work) -> f64;
     /// 1/2 v^T M v in physical space [J].
@@ -91,7 +91,7 @@ pub trait Space: Send + Sized + 'static {
 /// `scene` and binds it to the integrator `solver.integrator` names.
 pub(crate) fn build(scene: Scene, solver: &SolverParams) -> Result<Box<dyn Stepper>, PhysicsError> {
     match solver.reduction {
-        Reduction::Modal => Ok(integrator::bind(Modal::new(scene, solver.n_modes)?, solver.integrator)),
+        Reduction::Modal => Ok(integrator::bind(Modal::<Exact>::new(scene, solver.n_modes)?, solver.integrator)),
         Reduction::Full => Ok(integrator::bind(Full::new(scene, solver.n_modes)?, solver.integrator)),
     }
 }

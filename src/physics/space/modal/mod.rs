@@ -1,0 +1,304 @@
+//! The modal space: the paper's method (`docs/method.md`, section 3).
+//!
+//! y = q, the coordinates of the r kept modes, with x = x* + Phi q. The
+//! projected spring force Phi^T f(x* + Phi q) and its tangent come from a
+//! [`ReducedForce`]: [`Exact`] is the paper's pipeline `expand` (q -> x over
+//! the free DOFs) -> exact spring forces in physical space -> `project`
+//! (Phi^T f). With weights w_i and F = Phi^T (f_springs + M g) the mode
+//! equations are
+//!
+//! ```text
+//!     q_i'' + c_i q_i' = h_i(q) = w_i F_i + (w_i - 1) lambda_i q_i,
+//! ```
+//!
+//! i.e. q'' + c q' + lambda q = w r with r = F + lambda q: a weight scales
+//! everything that drives a mode beyond its own linear spring. M = I
+//! (Phi^T M Phi = I), C = diag(c_i), c_i = alpha + beta lambda_i.
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::lu::partial_pivoting::{factor::lu_in_place, factor::lu_in_place_scratch, solve::solve_in_place_scratch, solve::solve_in_place_with_conj};
+use faer::perm::PermRef;
+use faer::{Conj, Mat, MatMut, Par, Side};
+
+mod exact;
+
+pub use exact::Exact;
+
+use super::Space;
+use crate::physics::error::{PhysicsError, StepFailure};
+use crate::physics::forces::{add_reduced_tangent, linearize, omega_sq_bound_full};
+use crate::physics::modes::ModalBasis;
+use crate::physics::scene::Scene;
+use crate::physics::state::Loads;
+
+/// Above this many modes the explicit limit uses the full-space bound
+/// instead of the eigenvalues of the reduced taut stiffness.
+const DENSE_BOUND_MODES: usize = 64;
+
+/// How the modal space evaluates the projected spring force Phi^T f(x* + Phi q)
+/// and its tangent Phi^T K(x) Phi: every spring ([`Exact`]), or a model that
+/// leaves out what the kept modes do not need. A model is constant after
+/// set-up; its `Work` holds what one evaluation writes.
+pub trait ReducedForce: Send + Sized + 'static {
+    type Work: Send + 'static;
+    /// Set-up on `scene` for the kept `modes`.
+    fn new(scene: &Scene, modes: &Modes) -> Result<Self, PhysicsError>;
+    fn work(&self, scene: &Scene, modes: &Modes) -> Self::Work;
+    /// Phi^T f_springs(x* + Phi q) into `out` (r values).
+    fn project(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &mut Self::Work, out: &mut [f64]);
+    /// Adds Phi^T K(x) Phi (r x r, column-major) at the last [`Self::project`] to `kr`.
+    fn add_tangent(&self, scene: &Scene, modes: &Modes, w: &mut Self::Work, kr: &mut [f64]);
+    /// Slot positions at `q`, the coordinates of the last [`Self::project`].
+    fn positions<'w>(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &'w mut Self::Work) -> &'w [f64];
+    /// Elastic energy of every spring at `q`, the coordinates of the last [`Self::project`] [J].
+    fn elastic_energy(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &mut Self::Work) -> f64;
+}
+
+/// The kept modes, in the two layouts the loops want.
+pub struct Modes {
+    pub basis: ModalBasis,
+    /// Phi column-major (each mode contiguous), for the expand and project loops.
+    pub cols: Vec<f64>,
+}
+
+impl Modes {
+    fn new(basis: ModalBasis) -> Self {
+        let (n, r) = (basis.n, basis.r);
+        let cols = (0..r).flat_map(|j| (0..n).map(move |k| (k, j))).map(|(k, j)| basis.phi[k * r + j]).collect();
+        Modes { basis, cols }
+    }
+
+    /// x = x* + Phi q over the free DOFs (the first n values of the slot
+    /// positions `x`), one mode at a time.
+    pub fn expand(&self, rest: &[f64], q: &[f64], x: &mut [f64]) {
+        let n = self.basis.n;
+        x[..n].copy_from_slice(&rest[..n]);
+        for (col, qj) in self.cols.chunks_exact(n).zip(q) {
+            for (xk, p) in x[..n].iter_mut().zip(col) {
+                *xk += p * qj;
+            }
+        }
+    }
+
+    /// Phi^T f for a force `f` on the free DOFs.
+    pub fn project(&self, f: &[f64], out: &mut [f64]) {
+        for (o, col) in out.iter_mut().zip(self.cols.chunks_exact(self.basis.n)) {
+            *o = col.iter().zip(f).map(|(p, fk)| p * fk).sum::<f64>();
+        }
+    }
+
+    /// Phi v for modal rates `v`.
+    pub fn expand_rates(&self, v: &[f64], out: &mut [f64]) {
+        out.fill(0.0);
+        for (col, vj) in self.cols.chunks_exact(self.basis.n).zip(v) {
+            for (o, p) in out.iter_mut().zip(col) {
+                *o += p * vj;
+            }
+        }
+    }
+}
+
+/// The constant model of the modal equations, with force model `F`.
+pub struct Modal<F: ReducedForce = Exact> {
+    scene: Scene,
+    modes: Modes,
+    force: F,
+    frequencies: Vec<f64>,
+    /// Squared-frequency bound of the reduced system with unit weights.
+    omega_sq_bound: f64,
+    /// The modal coordinate of a one-length-scale displacement of the whole mass.
+    newton_scale: f64,
+}
+
+/// Load terms and scratch of a modal run.
+pub struct ModalWork<W> {
+    /// c_i = alpha + beta lambda_i.
+    damping: Vec<f64>,
+    /// Phi^T M g.
+    gravity: Vec<f64>,
+    /// What the force model writes.
+    force: W,
+    /// Reduced tangent Phi^T K(x) Phi (column-major).
+    kr: Vec<f64>,
+    /// Newton matrix, LU-factored in place, with its row permutation.
+    jac: Mat<f64>,
+    perm: Vec<usize>,
+    perm_inv: Vec<usize>,
+    mem: MemBuffer,
+}
+
+impl<F: ReducedForce> Modal<F> {
+    /// Linearizes `scene` at rest, keeps its `n_modes` lowest modes and sets up the force model.
+    pub fn new(scene: Scene, n_modes: usize) -> Result<Self, PhysicsError> {
+        let (pattern, k0) = linearize(&scene);
+        let basis = ModalBasis::lowest(&scene, &pattern, &k0, n_modes)?;
+        let omega_sq_bound = if basis.r <= DENSE_BOUND_MODES { taut_reduced_bound(&scene, &basis)? } else { omega_sq_bound_full(&scene) };
+        let newton_scale = scene.free_mass().sqrt() * scene.length_scale().max(f64::MIN_POSITIVE);
+        let frequencies = basis.frequencies();
+        let modes = Modes::new(basis);
+        let force = F::new(&scene, &modes)?;
+        Ok(Modal { force, frequencies, omega_sq_bound, newton_scale, modes, scene })
+    }
+
+    /// The kept modes.
+    pub fn basis(&self) -> &ModalBasis {
+        &self.modes.basis
+    }
+}
+
+impl<F: ReducedForce> Space for Modal<F> {
+    type Work = ModalWork<F::Work>;
+
+    fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    fn coordinates(&self) -> usize {
+        self.modes.basis.r
+    }
+
+    fn kept_modes(&self) -> Option<usize> {
+        Some(self.modes.basis.r)
+    }
+
+    fn frequencies(&self) -> &[f64] {
+        &self.frequencies
+    }
+
+    fn work(&self) -> ModalWork<F::Work> {
+        let r = self.modes.basis.r;
+        let req =
+            StackReq::any_of(&[lu_in_place_scratch::<usize, f64>(r, r, Par::Seq, Default::default()), solve_in_place_scratch::<usize, f64>(r, 1, Par::Seq)]);
+        ModalWork {
+            damping: vec![0.0; r],
+            gravity: vec![0.0; r],
+            force: self.force.work(&self.scene, &self.modes),
+            kr: vec![0.0; r * r],
+            jac: Mat::zeros(r, r),
+            perm: vec![0; r],
+            perm_inv: vec![0; r],
+            mem: MemBuffer::new(req),
+        }
+    }
+
+    fn apply_loads(&self, loads: &Loads, w: &mut Self::Work) {
+        let (n, r, d) = (self.modes.basis.n, self.modes.basis.r, self.scene.dim);
+        for j in 0..r {
+            w.damping[j] = loads.damping_alpha + loads.damping_beta * self.modes.basis.lambda[j];
+        }
+        w.gravity.fill(0.0);
+        for k in 0..n {
+            let fk = self.scene.dof_mass[k] * loads.gravity[k % d];
+            for j in 0..r {
+                w.gravity[j] += self.modes.basis.phi[k * r + j] * fk;
+            }
+        }
+    }
+
+    fn force(&self, loads: &Loads, q: &[f64], w: &mut Self::Work, h: &mut [f64]) {
+        // F = Phi^T (f + M g)
+        self.force.project(&self.scene, &self.modes, q, &mut w.force, h);
+        for (hj, gj) in h.iter_mut().zip(&w.gravity) {
+            *hj += gj;
+        }
+        // weights act on everything but the mode's own linear spring
+        for (j, hj) in h.iter_mut().enumerate() {
+            let wj = loads.mode_weights[j];
+            *hj = wj * *hj + (wj - 1.0) * self.modes.basis.lambda[j] * q[j];
+        }
+    }
+
+    fn explicit_velocity(&self, dt: f64, v: &[f64], a: &[f64], h: &[f64], w: &mut Self::Work, v1: &mut [f64]) -> Result<(), StepFailure> {
+        for j in 0..self.modes.basis.r {
+            v1[j] = (v[j] + 0.5 * dt * (a[j] + h[j])) / (1.0 + 0.5 * dt * w.damping[j]);
+        }
+        Ok(())
+    }
+
+    fn acceleration(&self, v: &[f64], h: &[f64], w: &mut Self::Work, a: &mut [f64]) {
+        for j in 0..self.modes.basis.r {
+            a[j] = h[j] - w.damping[j] * v[j];
+        }
+    }
+
+    fn residual(&self, v: &[f64], a: &[f64], h: &[f64], w: &mut Self::Work, r: &mut [f64]) {
+        for j in 0..self.modes.basis.r {
+            r[j] = -(a[j] + w.damping[j] * v[j] - h[j]);
+        }
+    }
+
+    /// J = c_m I + c_c diag(c) + W Phi^T K(x) Phi - diag((w - 1) lambda), LU with partial pivoting.
+    fn factor(&self, loads: &Loads, c_m: f64, c_c: f64, w: &mut Self::Work) -> Result<(), StepFailure> {
+        let r = self.modes.basis.r;
+        let weights = &loads.mode_weights;
+        w.kr.fill(0.0);
+        self.force.add_tangent(&self.scene, &self.modes, &mut w.force, &mut w.kr);
+        for col in 0..r {
+            for row in 0..r {
+                w.jac[(row, col)] = weights[row] * w.kr[col * r + row];
+            }
+            w.jac[(col, col)] += c_m + c_c * w.damping[col] - (weights[col] - 1.0) * self.modes.basis.lambda[col];
+        }
+        let stack = MemStack::new(&mut w.mem);
+        lu_in_place(w.jac.as_mut(), &mut w.perm, &mut w.perm_inv, Par::Seq, stack, Default::default());
+        Ok(())
+    }
+
+    fn solve(&self, w: &mut Self::Work, rhs: &mut [f64]) {
+        let r = self.modes.basis.r;
+        let row_perm = PermRef::new_checked(&w.perm, &w.perm_inv, r);
+        let jac = w.jac.as_ref();
+        let stack = MemStack::new(&mut w.mem);
+        solve_in_place_with_conj(jac, jac, row_perm, Conj::No, MatMut::from_column_major_slice_mut(rhs, r, 1), Par::Seq, stack);
+    }
+
+    fn newton_scale(&self) -> f64 {
+        self.newton_scale
+    }
+
+    /// Weights above 1 scale the stiffness each mode sees beyond its own.
+    fn omega_sq_bound(&self, loads: &Loads) -> f64 {
+        loads.weight_max() * self.omega_sq_bound
+    }
+
+    fn positions<'w>(&self, q: &[f64], w: &'w mut Self::Work) -> &'w [f64] {
+        self.force.positions(&self.scene, &self.modes, q, &mut w.force)
+    }
+
+    fn elastic_energy(&self, q: &[f64], w: &mut Self::Work) -> f64 {
+        self.force.elastic_energy(&self.scene, &self.modes, q, &mut w.force)
+    }
+
+    /// -(M g)^T u = -(Phi^T M g)^T q, relative to x*.
+    fn gravity_potential(&self, _loads: &Loads, q: &[f64], w: &Self::Work) -> f64 {
+        -w.gravity.iter().zip(q).map(|(g, q)| g * q).sum::<f64>()
+    }
+
+    /// 1/2 |q'|^2, since Phi^T M Phi = I.
+    fn kinetic_energy(&self, v: &[f64]) -> f64 {
+        0.5 * v.iter().map(|v| v * v).sum::<f64>()
+    }
+
+    /// Phi q'.
+    fn dof_velocities(&self, v: &[f64], out: &mut [f64]) {
+        self.modes.expand_rates(v, out);
+    }
+
+    fn modal_coordinates(&self, q: &[f64], out: &mut [f64]) {
+        out.copy_from_slice(q);
+    }
+}
+
+/// lambda_max(Phi^T K_taut Phi): bound on the squared frequencies of the
+/// reduced system in any state without compressed springs.
+fn taut_reduced_bound(scene: &Scene, basis: &ModalBasis) -> Result<f64, PhysicsError> {
+    let r = basis.r;
+    let mut kr = vec![0.0; r * r];
+    let mut work = vec![0.0; 6 * r];
+    add_reduced_tangent(scene, &scene.rest, &basis.phi, r, true, &mut kr, &mut work);
+    let m = faer::Mat::<f64>::from_fn(r, r, |i, j| kr[j * r + i]);
+    let ev = m
+        .self_adjoint_eigenvalues(Side::Lower)
+        .map_err(|e| PhysicsError::LinearAlgebra { what: "eigenvalues of the reduced stiffness", detail: format!("{e:?}") })?;
+    Ok(ev.last().copied().unwrap_or(0.0).max(0.0))
+}
