@@ -2,9 +2,13 @@
 //! and tangent stiffness.
 //!
 //! Every kernel walks the spring list once and is monomorphised on the
-//! dimension `D`, so the inner loops have fixed length. What is fixed after
+//! dimension `D`: the geometry of a spring (its vector, the sums at a node,
+//! its D x D stiffness block) is nalgebra's fixed-size `SVector` and
+//! `SMatrix`, so the inner loops have fixed length. What is fixed after
 //! set-up (incidence lists, stiffnesses, sparsity) is apart from the scratch
 //! a force evaluation writes ([`SpringScratch`]).
+
+use nalgebra::{SMatrix, SVector};
 
 use super::scene::{Scene, Spring};
 
@@ -100,14 +104,9 @@ impl SpringForces {
         let SpringScratch { g: gs, length_sq: length_sqs, tension: tensions } = scratch;
         // geometry
         for ((s, d), l2) in scene.springs.iter().zip(gs.chunks_exact_mut(D)).zip(length_sqs.iter_mut()) {
-            let xa = &x[s.a * D..s.a * D + D];
-            let xb = &x[s.b * D..s.b * D + D];
-            let mut sum = 0.0;
-            for i in 0..D {
-                d[i] = xb[i] - xa[i];
-                sum += d[i] * d[i];
-            }
-            *l2 = sum;
+            let diff = point::<D>(x, s.b) - point::<D>(x, s.a);
+            d.copy_from_slice(diff.as_slice());
+            *l2 = diff.norm_squared();
         }
         // tension
         let mut energy = [0.0; LANES];
@@ -124,19 +123,14 @@ impl SpringForces {
                 energy[i] += 0.5 * force[i] * stretch[i];
             }
         }
-        for (g, t) in gs.chunks_exact_mut(D).zip(tensions.iter()) {
-            for gi in g {
-                *gi *= t;
-            }
+        for (g, t) in gs.as_chunks_mut::<D>().0.iter_mut().zip(tensions.iter()) {
+            *g = (SVector::from(*g) * *t).into();
         }
         // gather
-        let sum = |springs: &[u32]| -> [f64; D] {
-            let mut acc = [0.0; D];
+        let sum = |springs: &[u32]| -> SVector<f64, D> {
+            let mut acc = SVector::<f64, D>::zeros();
             for &s in springs {
-                let g = &gs[s as usize * D..s as usize * D + D];
-                for i in 0..D {
-                    acc[i] += g[i];
-                }
+                acc += point::<D>(gs, s as usize);
             }
             acc
         };
@@ -144,9 +138,8 @@ impl SpringForces {
             let o = &self.offsets[2 * slot..2 * slot + 3];
             let starts = sum(&self.springs[o[0] as usize..o[1] as usize]);
             let stops = sum(&self.springs[o[1] as usize..o[2] as usize]);
-            for i in 0..D {
-                fs[i] += starts[i] - stops[i];
-            }
+            let fs: &mut [f64; D] = fs.try_into().expect("D values");
+            *fs = (SVector::from(*fs) + (starts - stops)).into();
         }
         energy.iter().sum()
     }
@@ -165,28 +158,26 @@ pub fn elastic_energy(scene: &Scene, x: &[f64]) -> f64 {
         .sum()
 }
 
-/// Tangent stiffness block of one spring, K_e = k [ u u^T + (1 - l0/l)(I - u u^T) ],
-/// in row-major `D x D`. `taut` replaces it by its bound k I (every direction
-/// as stiff as the axis), used for step-size limits.
+/// Tangent stiffness block of one spring, K_e = k [ u u^T + (1 - l0/l)(I - u u^T) ]
+/// (`docs/method.md`, section 2). `taut` replaces it by its bound k I (every
+/// direction as stiff as the axis), used for step-size limits.
 #[inline]
-pub fn spring_block<const D: usize>(s: &Spring, x: &[f64], taut: bool) -> [[f64; D]; D] {
-    let mut k = [[0.0; D]; D];
+pub fn spring_block<const D: usize>(s: &Spring, x: &[f64], taut: bool) -> SMatrix<f64, D, D> {
     if taut {
-        for (i, row) in k.iter_mut().enumerate() {
-            row[i] = s.k;
-        }
-        return k;
+        return SMatrix::from_diagonal_element(s.k);
     }
-    let d: [f64; D] = std::array::from_fn(|i| x[s.b * D + i] - x[s.a * D + i]);
-    let l = d.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let d = SVector::<f64, D>::from_fn(|i, _| x[s.b * D + i] - x[s.a * D + i]);
+    let l = d.norm();
     let geo = 1.0 - s.rest / l;
-    for i in 0..D {
-        for j in 0..D {
-            let uu = d[i] * d[j] / (l * l);
-            k[i][j] = s.k * ((1.0 - geo) * uu + if i == j { geo } else { 0.0 });
-        }
-    }
-    k
+    // k [ (1 - geo) u u^T + geo I ] with u u^T = d d^T / l^2, entry by entry
+    SMatrix::from_fn(|i, j| s.k * ((1.0 - geo) * (d[i] * d[j] / (l * l)) + if i == j { geo } else { 0.0 }))
+}
+
+/// The `D` coordinates of slot `slot` in a flat array.
+#[inline(always)]
+fn point<const D: usize>(x: &[f64], slot: usize) -> SVector<f64, D> {
+    let p: &[f64; D] = x[slot * D..slot * D + D].try_into().expect("D values");
+    SVector::from(*p)
 }
 
 /// Adds the reduced tangent Phi^T K(x) Phi (r x r, column-major) to `kr`:
@@ -205,7 +196,8 @@ fn reduced_tangent<const D: usize>(scene: &Scene, x: &[f64], phi: &[f64], r: usi
     let (g, rest) = work.split_at_mut(D * r);
     let kg = &mut rest[..D * r];
     for s in &scene.springs {
-        let ke = spring_block::<D>(s, x, taut);
+        // Symmetric, so its column-major array is also row-major.
+        let ke: [[f64; D]; D] = spring_block::<D>(s, x, taut).into();
         for i in 0..D {
             for j in 0..r {
                 let pa = if s.a < n_free { phi[(s.a * D + i) * r + j] } else { 0.0 };
@@ -307,7 +299,7 @@ impl StiffnessPattern {
     fn add_tangent_d<const D: usize>(&self, scene: &Scene, x: &[f64], scale: f64, vals: &mut [f64]) {
         let m = 2 * D;
         for (si, s) in scene.springs.iter().enumerate() {
-            let ke = spring_block::<D>(s, x, false);
+            let ke: [[f64; D]; D] = spring_block::<D>(s, x, false).into();
             let local = &self.local[si * m * m..(si + 1) * m * m];
             for p in 0..m {
                 for q in 0..m {

@@ -1,4 +1,4 @@
-"""The README's fmpy examples work as written."""
+"""The fmpy examples of the README and docs/usage.md work as written."""
 
 import re
 import subprocess
@@ -11,6 +11,7 @@ from fmpy import simulate_fmu
 from conftest import ROOT, cargo_available, fmu_path
 
 README = (ROOT / "README.md").read_text()
+USAGE = (ROOT / "docs" / "usage.md").read_text()
 
 
 def snippet(name):
@@ -34,9 +35,9 @@ def test_configuration_mode_snippet(default_fmu):
 
 
 def test_scene_baked_fmu_example(tmp_path):
-    line = next(l for l in README.splitlines() if l.startswith("cargo xtask fmu --scene paper-2d-top-corners"))
+    line = next(l for l in USAGE.splitlines() if l.startswith("cargo xtask fmu --scene paper-2d-top-corners"))
     args = line.split()[3:]  # --scene paper-2d-top-corners --nx 12 --modes 5
-    assert "target/fmu/paper-2d-top-corners-nx12-modes5.fmu" in README
+    assert "target/fmu/paper-2d-top-corners-nx12-modes5.fmu" in USAGE
     out = tmp_path / "scene.fmu"
     if not cargo_available():
         pytest.skip("cargo not on PATH")

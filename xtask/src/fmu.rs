@@ -5,8 +5,7 @@
 //! values), binaries/x86_64-linux/ModalMassSpring.so, documentation/index.html
 //! and resources/startValues.txt (the same start values, read by the binary).
 
-#[path = "../../modelDescription/generate.rs"]
-mod generate;
+use crate::generate;
 
 use std::collections::BTreeMap;
 use std::io::Write;

@@ -7,8 +7,13 @@
 //! - `setup`  install what the other tasks need (libclang, valgrind, Python venv with fmpy)
 //! - `fuzz`   the cargo-fuzz targets for a bounded time (`--seconds N`)
 //! - `valgrind` leak check of instantiate/step/serialize/free cycles
-//! - `stability` the stability matrix, its table written into the README
+//! - `stability` the stability matrix, its table written into docs/stability.md
+//! - `docs`   the variable tables of the README, from modelDescription/variables.toml
 
+#[path = "../../modelDescription/generate.rs"]
+mod generate;
+
+mod docs;
 mod fmu;
 mod fuzz;
 mod report;
@@ -34,8 +39,9 @@ fn main() -> ExitCode {
         "fuzz" => fuzz::main(rest),
         "valgrind" => valgrind::main(rest),
         "stability" => stability::main(rest),
+        "docs" => docs::main(rest),
         _ => {
-            eprintln!("usage: cargo xtask <fmu|run|test|report|setup|fuzz|valgrind|stability> [options]");
+            eprintln!("usage: cargo xtask <fmu|run|test|report|setup|fuzz|valgrind|stability|docs> [options]");
             return ExitCode::from(2);
         }
     };

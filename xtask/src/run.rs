@@ -22,7 +22,7 @@ use crate::{fmu, fuzz, setup, valgrind};
 /// on the others (features are unified over the packages a build selects).
 const TEST_CARGO_ARGS: [&str; 3] = ["--workspace", "--features", "modal_mass_spring/xsd"];
 
-/// Fuzzing time per target in `cargo xtask test` (CI): bounded, see README.
+/// Fuzzing time per target in `cargo xtask test` (CI): bounded, see docs/robustness.md.
 const FUZZ_SECONDS: u64 = 30;
 
 fn fmu_dir(root: &Path) -> PathBuf {

@@ -1,5 +1,5 @@
 //! `cargo xtask stability`: runs the stability matrix (tests/stability.rs)
-//! and writes its table into the README, between the markers the test
+//! and writes its table into docs/stability.md, between the markers the test
 //! checks on every other run.
 
 use std::process::Command;
@@ -15,8 +15,8 @@ pub fn main(args: &[String]) -> Result<(), String> {
         .status()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
     if !status.success() {
-        return Err("the stability matrix failed (the README's table was written only if every cell passed its checks)".into());
+        return Err("the stability matrix failed (docs/stability.md was written only if every cell passed its checks)".into());
     }
-    println!("README.md: stability table written (the full output is in target/stability.md)");
+    println!("docs/stability.md: stability table written (the full output is in target/stability.md)");
     Ok(())
 }
