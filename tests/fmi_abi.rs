@@ -617,6 +617,14 @@ fn every_corruption_of_a_serialized_state_is_refused() {
         b
     };
     refused_unchanged(&f, &resealed(&|b| b[8] = 1), "format version 1");
+    // Format 2 held the simulator state as one concatenated array: a state
+    // of the FMU's previous version is refused, saying so.
+    let older = resealed(&|b| b[8..12].copy_from_slice(&2u32.to_le_bytes()));
+    let (s, _) = f.deserialize(&older);
+    assert_eq!(s, ERROR);
+    let logged = f.log.take();
+    assert!(logged.last().is_some_and(|(_, _, m)| m.contains("format 2 was written by an older version")), "{logged:?}");
+    refused_unchanged(&f, &older, "format version 2");
     refused_unchanged(&f, &resealed(&|b| b[8..12].copy_from_slice(&99u32.to_le_bytes())), "format version 99");
     refused_unchanged(&f, &resealed(&|b| b[12] ^= 1), "another variable layout");
     refused_unchanged(&f, &resealed(&|b| b[0] = b'X'), "another magic");

@@ -196,8 +196,7 @@ fn reduced_tangent<const D: usize>(scene: &Scene, x: &[f64], phi: &[f64], r: usi
     let (g, rest) = work.split_at_mut(D * r);
     let kg = &mut rest[..D * r];
     for s in &scene.springs {
-        // Symmetric, so its column-major array is also row-major.
-        let ke: [[f64; D]; D] = spring_block::<D>(s, x, taut).into();
+        let ke = spring_block::<D>(s, x, taut);
         for i in 0..D {
             for j in 0..r {
                 let pa = if s.a < n_free { phi[(s.a * D + i) * r + j] } else { 0.0 };
@@ -207,7 +206,7 @@ fn reduced_tangent<const D: usize>(scene: &Scene, x: &[f64], phi: &[f64], r: usi
         }
         for i in 0..D {
             for j in 0..r {
-                kg[i * r + j] = (0..D).map(|m| ke[i][m] * g[m * r + j]).sum();
+                kg[i * r + j] = (0..D).map(|m| ke[(i, m)] * g[m * r + j]).sum();
             }
         }
         for col in 0..r {
@@ -299,14 +298,14 @@ impl StiffnessPattern {
     fn add_tangent_d<const D: usize>(&self, scene: &Scene, x: &[f64], scale: f64, vals: &mut [f64]) {
         let m = 2 * D;
         for (si, s) in scene.springs.iter().enumerate() {
-            let ke: [[f64; D]; D] = spring_block::<D>(s, x, false).into();
+            let ke = spring_block::<D>(s, x, false);
             let local = &self.local[si * m * m..(si + 1) * m * m];
             for p in 0..m {
                 for q in 0..m {
                     let pos = local[p * m + q];
                     if pos != SKIP {
                         let sign = if (p < D) == (q < D) { scale } else { -scale };
-                        vals[pos] += sign * ke[p % D][q % D];
+                        vals[pos] += sign * ke[(p % D, q % D)];
                     }
                 }
             }
