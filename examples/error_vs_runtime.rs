@@ -51,7 +51,14 @@ fn main() {
     let p = scenes::canonical(name).expect("unknown scene").grid;
     let n = p.build().unwrap().n_dofs();
     let frames = (seconds * 100.0).round() as usize; // output every 10 ms
-    let full = |integrator, h: f64| SolverParams { reduction: Reduction::Full, integrator, n_modes: 0, max_internal_step: h, substepping: true };
+    let full = |integrator, h: f64| SolverParams {
+        reduction: Reduction::Full,
+        integrator,
+        n_modes: 0,
+        max_internal_step: h,
+        substepping: true,
+        basis: BasisOptions::default(),
+    };
     let reference_h = 1e-4;
     let reference = simulate(&p, &full(Integrator::NewmarkImplicit, reference_h), reference_h, 100, frames).unwrap();
     let half = simulate(&p, &full(Integrator::NewmarkImplicit, reference_h / 2.0), reference_h / 2.0, 200, frames).unwrap();
@@ -63,7 +70,14 @@ fn main() {
     let mut rows = vec![];
     for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit] {
         for r in [2, 8, n] {
-            rows.push(SolverParams { reduction: Reduction::Modal, integrator, n_modes: r, max_internal_step: h, substepping: true });
+            rows.push(SolverParams {
+                reduction: Reduction::Modal,
+                integrator,
+                n_modes: r,
+                max_internal_step: h,
+                substepping: true,
+                basis: BasisOptions::default(),
+            });
         }
         rows.push(full(integrator, h));
     }

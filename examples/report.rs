@@ -148,7 +148,14 @@ fn main() {
     for (ci, case) in cases.iter().enumerate() {
         let p = &case.params;
         let n = p.build().unwrap().n_dofs();
-        let full = |integrator, max_internal_step| SolverParams { reduction: Reduction::Full, integrator, n_modes: 0, max_internal_step, substepping: true };
+        let full = |integrator, max_internal_step| SolverParams {
+            reduction: Reduction::Full,
+            integrator,
+            n_modes: 0,
+            max_internal_step,
+            substepping: true,
+            basis: BasisOptions::default(),
+        };
         let mut mode_counts: Vec<usize> = std::iter::successors(Some(1usize), |r| Some(r * 2)).take_while(|&r| r < n).collect();
         // Beyond a quarter of the DOFs the basis needs the dense eigensolver;
         // of those, only all modes are run (set-up alone takes tens of
@@ -167,7 +174,14 @@ fn main() {
             for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit] {
                 list.push(Plan { solver: full(integrator, h), step: h, step_label: label.into(), note: String::new() });
                 for &r in &mode_counts {
-                    let solver = SolverParams { reduction: Reduction::Modal, integrator, n_modes: r, max_internal_step: h, substepping: true };
+                    let solver = SolverParams {
+                        reduction: Reduction::Modal,
+                        integrator,
+                        n_modes: r,
+                        max_internal_step: h,
+                        substepping: true,
+                        basis: BasisOptions::default(),
+                    };
                     // The implicit Newton matrix Phi^T K(x) Phi costs about
                     // springs x r^2 x 30 flops per iteration; beyond
                     // IMPLICIT_TANGENT_LIMIT a single step takes seconds.
@@ -205,7 +219,14 @@ fn main() {
         let case = &cases[ci];
         let p = &case.params;
         let n = p.build().unwrap().n_dofs();
-        let full = |integrator, max_internal_step| SolverParams { reduction: Reduction::Full, integrator, n_modes: 0, max_internal_step, substepping: true };
+        let full = |integrator, max_internal_step| SolverParams {
+            reduction: Reduction::Full,
+            integrator,
+            n_modes: 0,
+            max_internal_step,
+            substepping: true,
+            basis: BasisOptions::default(),
+        };
         bar.set_message(format!("{}: reference", case.label));
         let reference = simulate(p, &full(Integrator::NewmarkExplicit, reference_dt), reference_dt, seconds, f64::INFINITY).expect("reference run failed");
         bar.inc(1);

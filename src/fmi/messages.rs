@@ -61,6 +61,17 @@ pub fn describe(e: &PhysicsError, p: &Params) -> String {
         ),
         NegativeEigenvalue { lambda } => format!("the stiffness matrix at rest has a negative eigenvalue {lambda}"),
         LinearAlgebra { .. } => e.to_string(),
+        NoEquilibrium { load_fraction, residual } => format!(
+            "linearization = equilibrium: no static equilibrium found under gravity (Newton reached {load_fraction} of the load \
+             with a residual of {residual:.2e} of the gravity force); use linearization = rest, or less gravity"
+        ),
+        UnstableEquilibrium => "linearization = equilibrium: every equilibrium found under gravity is unstable (its stiffness has a \
+                                negative eigenvalue); use linearization = rest"
+            .into(),
+        NoLoad => "modeSelection = load and staticCorrection = true build the basis from the loads at set-up, and gravity is zero: \
+                   set gravity before initialization, or use modeSelection = lowest without staticCorrection"
+            .into(),
+        BasisDeficient { wanted, found } => format!("the basis has {found} independent vectors, nModes = {wanted}: keep fewer modes"),
         ExplicitTooStiff { stable_step, omega_max, stiffness_per_mass, per_step, max_internal_step, limit, modes } => {
             let kept = match modes {
                 Some(r) => format!("the {r} kept modes"),

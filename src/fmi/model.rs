@@ -4,8 +4,8 @@
 //! [`super`].
 
 use super::variables::{index_of, vr, Dim, Variability, Variable, SCENES, VARIABLES};
-use crate::options::{FixedNodes, Integrator, Reduction};
-use crate::physics::{Grid, Loads, PhysicsError, Simulator, SolverParams};
+use crate::options::{FixedNodes, Integrator, Linearization, ModeSelection, Reduction};
+use crate::physics::{BasisOptions, Grid, Loads, PhysicsError, Simulator, SolverParams};
 
 /// Current values of the parameters and inputs, indexed like [`VARIABLES`]
 /// (empty for the other variables). Booleans are 0/1, integers exact
@@ -142,6 +142,11 @@ impl Params {
             reduction: self.enumeration(vr::REDUCTION, Reduction::from_value),
             integrator: self.enumeration(vr::INTEGRATOR, Integrator::from_value),
             n_modes: self.count(vr::N_MODES),
+            basis: BasisOptions {
+                selection: self.enumeration(vr::MODE_SELECTION, ModeSelection::from_value),
+                static_correction: self.scalar(vr::STATIC_CORRECTION) != 0.0,
+                linearization: self.enumeration(vr::LINEARIZATION, Linearization::from_value),
+            },
             max_internal_step: self.scalar(vr::MAX_INTERNAL_STEP),
             substepping: true,
         }

@@ -27,6 +27,8 @@ pub trait Stepper: Send {
     fn omega_sq_bound(&self, loads: &Loads) -> f64;
     /// Derives the load terms of the space from `loads`.
     fn apply_loads(&mut self, loads: &Loads);
+    /// The coordinates of the scene at rest.
+    fn rest_coordinates(&self, y: &mut [f64]);
     /// Evaluates the forces at `state.y` (positions and elastic energy
     /// follow it) and sets `state.a` from them: at the start, and after a
     /// change of loads, which then acts as a step input.
@@ -114,6 +116,10 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
 
     fn apply_loads(&mut self, loads: &Loads) {
         self.space.apply_loads(loads, &mut self.work);
+    }
+
+    fn rest_coordinates(&self, y: &mut [f64]) {
+        self.space.rest_coordinates(y);
     }
 
     fn settle(&mut self, loads: &Loads, state: &mut State) {

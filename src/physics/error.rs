@@ -133,6 +133,16 @@ pub enum PhysicsError {
     NegativeEigenvalue { lambda: f64 },
     /// A factorization or eigen decomposition failed.
     LinearAlgebra { what: &'static str, detail: String },
+    /// No static equilibrium under the loads: Newton stopped at this
+    /// fraction of the load, with this largest residual force relative to
+    /// the largest gravity force.
+    NoEquilibrium { load_fraction: f64, residual: f64 },
+    /// Every equilibrium found is unstable (its stiffness has a negative eigenvalue).
+    UnstableEquilibrium,
+    /// A basis built from the loads, and the loads are zero.
+    NoLoad,
+    /// The candidate vectors span fewer independent directions than asked for.
+    BasisDeficient { wanted: usize, found: usize },
     /// The explicit integrator would need more than `limit` internal steps
     /// per internal step bound: the scene is too stiff for it.
     ExplicitTooStiff {
@@ -202,6 +212,16 @@ impl fmt::Display for PhysicsError {
             ),
             NegativeEigenvalue { lambda } => write!(f, "the stiffness at the linearization point has a negative eigenvalue {lambda}"),
             LinearAlgebra { what, detail } => write!(f, "{what} failed: {detail}"),
+            NoEquilibrium { load_fraction, residual } => write!(
+                f,
+                "no static equilibrium found under gravity: Newton reached {load_fraction} of the load with a residual of \
+                 {residual:.2e} of the gravity force; linearize at rest"
+            ),
+            UnstableEquilibrium => {
+                f.write_str("every equilibrium found under gravity is unstable (its stiffness has a negative eigenvalue); linearize at rest")
+            }
+            NoLoad => f.write_str("modes chosen by the loads, or a static correction, need a load at set-up, and gravity is zero"),
+            BasisDeficient { wanted, found } => write!(f, "the basis has {found} independent vectors, {wanted} were asked for"),
             ExplicitTooStiff { stable_step, omega_max, stiffness_per_mass, per_step, max_internal_step, limit, modes } => {
                 let kept = match modes {
                     Some(r) => format!("the {r} kept modes"),

@@ -5,6 +5,7 @@
 //!   builds the canonical scenes, nothing else knows there is a grid;
 //! - [`forces`]: exact spring forces, tangent stiffness, sparsity;
 //! - [`modes`]: the generalized eigen decomposition K phi = lambda M phi;
+//! - [`basis`]: where to linearize ([`equilibrium`]), which modes to keep, the static correction;
 //! - [`space`]: where the equations M y'' + C y' = h(y) live (modal, full),
 //!   each a constant model with its own scratch;
 //! - [`integrator`]: the schemes (explicit and implicit Newmark), written
@@ -17,7 +18,9 @@
 //! One modal force evaluation is the pipeline `expand` (q -> x) -> exact
 //! spring forces in physical space -> `project` (Phi^T f).
 
+pub mod basis;
 pub mod engine;
+pub mod equilibrium;
 pub mod error;
 pub mod forces;
 pub mod grid;
@@ -28,6 +31,7 @@ pub mod simulator;
 pub mod space;
 pub mod state;
 
+pub use basis::{BasisOptions, Linearization, ModeSelection};
 pub use error::{PhysicsError, Quantity, StepFailure};
 pub use grid::{FixedNodes, Grid};
 pub use integrator::{Integrator, EXPLICIT_SAFETY};

@@ -6,6 +6,7 @@
 //! [`Loads`], a backup of the state taken before every communication step,
 //! and the [`Outputs`] of the last good step.
 
+use super::basis::BasisOptions;
 use super::engine::{Outputs, Stepper};
 use super::error::{positive, Expected, PhysicsError, Quantity, StepFailure};
 use super::integrator::Integrator;
@@ -23,6 +24,8 @@ pub struct SolverParams {
     /// Modes kept by the modal space; in full space the number of modes
     /// whose frequencies and coordinates are reported (0: none).
     pub n_modes: usize,
+    /// How the modes are chosen (`docs/method.md`, section 3).
+    pub basis: BasisOptions,
     /// Upper bound on one internal step [s].
     pub max_internal_step: f64,
     /// Split a communication step into internal steps that keep the
@@ -33,7 +36,7 @@ pub struct SolverParams {
 impl SolverParams {
     /// `n_modes` modes, the given space and scheme, internal steps of at most 10 ms.
     pub fn new(reduction: Reduction, integrator: Integrator, n_modes: usize) -> Self {
-        SolverParams { reduction, integrator, n_modes, max_internal_step: 0.01, substepping: true }
+        SolverParams { reduction, integrator, n_modes, basis: BasisOptions::default(), max_internal_step: 0.01, substepping: true }
     }
 }
 
@@ -91,9 +94,10 @@ impl Simulator {
         }
         loads.validate(solver.n_modes)?;
         let (free_mass, reach) = (scene.free_mass(), scene.reach());
-        let mut engine = space::build(scene, solver)?;
+        let mut engine = space::build(scene, solver, loads)?;
         engine.apply_loads(loads);
         let mut state = State::at_rest(engine.coordinates());
+        engine.rest_coordinates(&mut state.y);
         engine.settle(loads, &mut state);
         let mut sim = Simulator {
             outputs: Outputs::new(engine.scene(), solver.n_modes),

@@ -17,6 +17,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
 use super::Space;
+use crate::physics::basis::{self, BasisOptions};
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::forces::{linearize, omega_sq_bound_full, SpringForces, SpringScratch, StiffnessPattern};
 use crate::physics::modes::ModalBasis;
@@ -33,6 +34,8 @@ pub struct Full {
     symbolic: SymbolicCholesky<usize>,
     /// Modes whose coordinates and frequencies are reported, if any.
     reported: Option<ModalBasis>,
+    /// x_rest - x* of the reported modes, when x* is not the rest positions.
+    reported_offset: Option<Vec<f64>>,
     frequencies: Vec<f64>,
     omega_sq_bound: f64,
     newton_scale: f64,
@@ -62,10 +65,17 @@ pub struct FullWork {
 
 impl Full {
     /// Assembles the stiffness at rest and its symbolic Cholesky analysis;
-    /// decomposes it into the `reported_modes` lowest modes when that is not 0.
-    pub fn new(scene: Scene, reported_modes: usize) -> Result<Self, PhysicsError> {
+    /// builds the basis of `reported_modes` vectors `options` ask for (under
+    /// the set-up `loads`) when that is not 0, to report its coordinates.
+    pub fn new(scene: Scene, reported_modes: usize, loads: &Loads, options: &BasisOptions) -> Result<Self, PhysicsError> {
         let (pattern, k0) = linearize(&scene);
-        let reported = if reported_modes > 0 { Some(ModalBasis::lowest(&scene, &pattern, &k0, reported_modes)?) } else { None };
+        let (reported, reported_offset) = if reported_modes > 0 {
+            let b = basis::build(&scene, loads, reported_modes, options)?;
+            let offset = (!b.at_rest).then(|| (0..scene.n_dofs()).map(|k| scene.rest[k] - b.point[k]).collect());
+            (Some(b.modes), offset)
+        } else {
+            (None, None)
+        };
         let n = scene.n_dofs();
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx);
         let symbolic = factorize_symbolic_cholesky(sym, Side::Upper, SymmetricOrdering::Amd, Default::default())
@@ -76,6 +86,7 @@ impl Full {
             omega_sq_bound: omega_sq_bound_full(&scene),
             newton_scale: scene.length_scale().max(1e-300),
             reported,
+            reported_offset,
             symbolic,
             pattern,
             k0,
@@ -170,6 +181,11 @@ impl Space for Full {
             mem: MemBuffer::new(req),
             explicit_factor: None,
         }
+    }
+
+    /// u = 0: the full space measures from the rest positions.
+    fn rest_coordinates(&self, u: &mut [f64]) {
+        u.fill(0.0);
     }
 
     fn apply_loads(&self, loads: &Loads, w: &mut FullWork) {
@@ -275,10 +291,16 @@ impl Space for Full {
         out.copy_from_slice(v);
     }
 
-    /// q = Phi^T M u on the reported modes.
+    /// q = Phi^T M (x - x*) on the reported modes.
     fn modal_coordinates(&self, u: &[f64], out: &mut [f64]) {
         if let Some(b) = &self.reported {
-            b.project_displacement(&self.scene.dof_mass, u, out);
+            match &self.reported_offset {
+                None => b.project_displacement(&self.scene.dof_mass, u, out),
+                Some(offset) => {
+                    let d: Vec<f64> = u.iter().zip(offset).map(|(a, b)| a + b).collect();
+                    b.project_displacement(&self.scene.dof_mass, &d, out);
+                }
+            }
         }
     }
 }

@@ -50,6 +50,9 @@ pub trait Space: Send + Sized + 'static {
     fn frequencies(&self) -> &[f64];
     /// Fresh load terms (all zero) and scratch.
     fn work(&self) -> Self::Work;
+    /// The coordinates of the scene at rest, where every run starts (0
+    /// unless the coordinates are measured from another point than rest).
+    fn rest_coordinates(&self, y: &mut [f64]);
 
     /// Derives the load terms (damping per coordinate, generalized gravity) from `loads`.
     fn apply_loads(&self, loads: &Loads, w: &mut Self::Work);
@@ -89,9 +92,10 @@ pub trait Space: Send + Sized + 'static {
 
 /// The registry of spaces: builds the space `solver.reduction` names on
 /// `scene` and binds it to the integrator `solver.integrator` names.
-pub(crate) fn build(scene: Scene, solver: &SolverParams) -> Result<Box<dyn Stepper>, PhysicsError> {
+/// `loads` are those at set-up: the basis options that depend on the loads use them.
+pub(crate) fn build(scene: Scene, solver: &SolverParams, loads: &Loads) -> Result<Box<dyn Stepper>, PhysicsError> {
     match solver.reduction {
-        Reduction::Modal => Ok(integrator::bind(Modal::<Exact>::new(scene, solver.n_modes)?, solver.integrator)),
-        Reduction::Full => Ok(integrator::bind(Full::new(scene, solver.n_modes)?, solver.integrator)),
+        Reduction::Modal => Ok(integrator::bind(Modal::<Exact>::new(scene, solver.n_modes, loads, &solver.basis)?, solver.integrator)),
+        Reduction::Full => Ok(integrator::bind(Full::new(scene, solver.n_modes, loads, &solver.basis)?, solver.integrator)),
     }
 }

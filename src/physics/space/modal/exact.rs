@@ -42,7 +42,7 @@ impl ReducedForce for Exact {
     }
 
     fn project(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &mut ExactWork, out: &mut [f64]) {
-        modes.expand(&scene.rest, q, &mut w.x);
+        modes.expand(q, &mut w.x);
         w.f.fill(0.0);
         w.elastic = self.springs.add_to(scene, &w.x, &mut w.springs, &mut w.f);
         modes.project(&w.f, out);

@@ -25,8 +25,9 @@ mod exact;
 pub use exact::Exact;
 
 use super::Space;
+use crate::physics::basis::{self, BasisOptions};
 use crate::physics::error::{PhysicsError, StepFailure};
-use crate::physics::forces::{add_reduced_tangent, linearize, omega_sq_bound_full};
+use crate::physics::forces::{add_reduced_tangent, omega_sq_bound_full};
 use crate::physics::modes::ModalBasis;
 use crate::physics::scene::Scene;
 use crate::physics::state::Loads;
@@ -54,25 +55,30 @@ pub trait ReducedForce: Send + Sized + 'static {
     fn elastic_energy(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &mut Self::Work) -> f64;
 }
 
-/// The kept modes, in the two layouts the loops want.
+/// The kept modes, in the two layouts the loops want, and the point x*
+/// they are measured from.
 pub struct Modes {
     pub basis: ModalBasis,
     /// Phi column-major (each mode contiguous), for the expand and project loops.
     pub cols: Vec<f64>,
+    /// Slot positions x* (the rest positions, or the equilibrium).
+    pub point: Vec<f64>,
+    /// x* is the rest positions.
+    pub at_rest: bool,
 }
 
 impl Modes {
-    fn new(basis: ModalBasis) -> Self {
+    fn new(basis: ModalBasis, point: Vec<f64>, at_rest: bool) -> Self {
         let (n, r) = (basis.n, basis.r);
         let cols = (0..r).flat_map(|j| (0..n).map(move |k| (k, j))).map(|(k, j)| basis.phi[k * r + j]).collect();
-        Modes { basis, cols }
+        Modes { basis, cols, point, at_rest }
     }
 
     /// x = x* + Phi q over the free DOFs (the first n values of the slot
-    /// positions `x`), one mode at a time.
-    pub fn expand(&self, rest: &[f64], q: &[f64], x: &mut [f64]) {
+    /// positions `x`, whose other slots stay as they are), one mode at a time.
+    pub fn expand(&self, q: &[f64], x: &mut [f64]) {
         let n = self.basis.n;
-        x[..n].copy_from_slice(&rest[..n]);
+        x[..n].copy_from_slice(&self.point[..n]);
         for (col, qj) in self.cols.chunks_exact(n).zip(q) {
             for (xk, p) in x[..n].iter_mut().zip(col) {
                 *xk += p * qj;
@@ -116,6 +122,8 @@ pub struct ModalWork<W> {
     damping: Vec<f64>,
     /// Phi^T M g.
     gravity: Vec<f64>,
+    /// -(M g)^T (x* - x_rest): the gravity potential at q = 0.
+    gravity_offset: f64,
     /// What the force model writes.
     force: W,
     /// Reduced tangent Phi^T K(x) Phi (column-major).
@@ -128,14 +136,15 @@ pub struct ModalWork<W> {
 }
 
 impl<F: ReducedForce> Modal<F> {
-    /// Linearizes `scene` at rest, keeps its `n_modes` lowest modes and sets up the force model.
-    pub fn new(scene: Scene, n_modes: usize) -> Result<Self, PhysicsError> {
-        let (pattern, k0) = linearize(&scene);
-        let basis = ModalBasis::lowest(&scene, &pattern, &k0, n_modes)?;
+    /// Builds the basis of `n_modes` vectors `options` ask for (under the
+    /// set-up `loads`) and sets up the force model.
+    pub fn new(scene: Scene, n_modes: usize, loads: &Loads, options: &BasisOptions) -> Result<Self, PhysicsError> {
+        let built = basis::build(&scene, loads, n_modes, options)?;
+        let basis = built.modes;
         let omega_sq_bound = if basis.r <= DENSE_BOUND_MODES { taut_reduced_bound(&scene, &basis)? } else { omega_sq_bound_full(&scene) };
         let newton_scale = scene.free_mass().sqrt() * scene.length_scale().max(f64::MIN_POSITIVE);
         let frequencies = basis.frequencies();
-        let modes = Modes::new(basis);
+        let modes = Modes::new(basis, built.point, built.at_rest);
         let force = F::new(&scene, &modes)?;
         Ok(Modal { force, frequencies, omega_sq_bound, newton_scale, modes, scene })
     }
@@ -172,6 +181,7 @@ impl<F: ReducedForce> Space for Modal<F> {
         ModalWork {
             damping: vec![0.0; r],
             gravity: vec![0.0; r],
+            gravity_offset: 0.0,
             force: self.force.work(&self.scene, &self.modes),
             kr: vec![0.0; r * r],
             jac: Mat::zeros(r, r),
@@ -181,17 +191,31 @@ impl<F: ReducedForce> Space for Modal<F> {
         }
     }
 
+    /// q = Phi^T M (x_rest - x*): the rest positions as the basis sees them
+    /// (exact when they lie in its span, as with a static correction).
+    fn rest_coordinates(&self, q: &mut [f64]) {
+        q.fill(0.0);
+        if self.modes.at_rest {
+            return;
+        }
+        let n = self.modes.basis.n;
+        let u: Vec<f64> = (0..n).map(|k| self.scene.rest[k] - self.modes.point[k]).collect();
+        self.modes.basis.project_displacement(&self.scene.dof_mass, &u, q);
+    }
+
     fn apply_loads(&self, loads: &Loads, w: &mut Self::Work) {
         let (n, r, d) = (self.modes.basis.n, self.modes.basis.r, self.scene.dim);
         for j in 0..r {
             w.damping[j] = loads.damping_alpha + loads.damping_beta * self.modes.basis.lambda[j];
         }
         w.gravity.fill(0.0);
+        w.gravity_offset = 0.0;
         for k in 0..n {
             let fk = self.scene.dof_mass[k] * loads.gravity[k % d];
             for j in 0..r {
                 w.gravity[j] += self.modes.basis.phi[k * r + j] * fk;
             }
+            w.gravity_offset -= fk * (self.modes.point[k] - self.scene.rest[k]);
         }
     }
 
@@ -269,9 +293,14 @@ impl<F: ReducedForce> Space for Modal<F> {
         self.force.elastic_energy(&self.scene, &self.modes, q, &mut w.force)
     }
 
-    /// -(M g)^T u = -(Phi^T M g)^T q, relative to x*.
+    /// -(M g)^T (x - x_rest) = -(M g)^T (x* - x_rest) - (Phi^T M g)^T q.
     fn gravity_potential(&self, _loads: &Loads, q: &[f64], w: &Self::Work) -> f64 {
-        -w.gravity.iter().zip(q).map(|(g, q)| g * q).sum::<f64>()
+        let modal = -w.gravity.iter().zip(q).map(|(g, q)| g * q).sum::<f64>();
+        if self.modes.at_rest {
+            modal
+        } else {
+            w.gravity_offset + modal
+        }
     }
 
     /// 1/2 |q'|^2, since Phi^T M Phi = I.

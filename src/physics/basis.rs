@@ -1,0 +1,311 @@
+//! The modal basis a scene needs (`docs/method.md`, section 3): where to
+//! linearize, which modes to keep, and whether to add the static response
+//! to the loads.
+//!
+//! - **Linearization** at rest (the paper), or at the static equilibrium
+//!   under the loads ([`super::equilibrium`]), where the stiffness includes
+//!   the geometric stiffness of the stretched springs.
+//! - **Selection**: the r lowest modes (the paper), or the r modes that
+//!   carry most of the static response to the loads, ranked by
+//!   |φ_iᵀ f| / λ_i for each load pattern f. On scenes up to
+//!   [`DENSE_CANDIDATES`] free DOFs every mode is a candidate; above, the
+//!   candidates are the Ritz pairs of a Krylov space grown from K⁻¹ f
+//!   (load-dependent Ritz vectors, Wilson, Yuan and Dickens 1982), which
+//!   reaches the loaded modes from one sparse factorization however many
+//!   unloaded modes lie below them.
+//! - **Static correction**: the static responses K⁻¹ f join the kept modes;
+//!   the enriched set is M-orthonormalized and diagonalized in its own
+//!   span (Rayleigh–Ritz), so every basis vector has a frequency and
+//!   Φᵀ M Φ = I, Φᵀ K Φ = diag(λ) hold as for eigenmodes. The number of
+//!   modes counts every basis vector.
+
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Mat, Side};
+
+use super::equilibrium::equilibrium;
+use super::error::PhysicsError;
+use super::forces::StiffnessPattern;
+use super::modes::ModalBasis;
+use super::scene::Scene;
+use super::state::Loads;
+pub use crate::options::{Linearization, ModeSelection};
+
+/// Scenes up to this many free DOFs rank every mode (a dense decomposition);
+/// larger ones rank load-dependent Ritz pairs.
+pub const DENSE_CANDIDATES: usize = 1500;
+/// Krylov vectors per kept mode in the load-dependent Ritz space (and at least this many more than kept).
+const RITZ_FACTOR: usize = 4;
+const RITZ_EXTRA: usize = 16;
+/// A vector whose M-norm falls below this fraction of its own after
+/// orthogonalization against the basis is taken as already in it.
+const DEPENDENT: f64 = 1e-8;
+
+/// How the basis is built.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BasisOptions {
+    pub selection: ModeSelection,
+    pub static_correction: bool,
+    pub linearization: Linearization,
+}
+
+impl Default for BasisOptions {
+    /// The paper's: the lowest modes at rest, no correction.
+    fn default() -> Self {
+        BasisOptions { selection: ModeSelection::Lowest, static_correction: false, linearization: Linearization::Rest }
+    }
+}
+
+/// A linearization point and the modes built there.
+pub struct Basis {
+    /// Slot positions x* the modal coordinates are measured from.
+    pub point: Vec<f64>,
+    /// x* is the rest positions of the scene.
+    pub at_rest: bool,
+    pub pattern: StiffnessPattern,
+    /// Upper triangle of the stiffness K(x*).
+    pub stiffness: Vec<f64>,
+    pub modes: ModalBasis,
+}
+
+/// The load patterns the options rank and correct for: M g, when gravity is not zero.
+pub fn load_patterns(scene: &Scene, loads: &Loads) -> Vec<Vec<f64>> {
+    let d = scene.dim;
+    let g = &loads.gravity[..d];
+    if g.iter().all(|&x| x == 0.0) {
+        return Vec::new();
+    }
+    vec![(0..scene.n_dofs()).map(|k| scene.dof_mass[k] * g[k % d]).collect()]
+}
+
+/// The basis of `n_modes` vectors `options` ask for on `scene` under `loads`.
+pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, options: &BasisOptions) -> Result<Basis, PhysicsError> {
+    let n = scene.n_dofs();
+    if n_modes > n {
+        return Err(PhysicsError::ModesExceedDofs { modes: n_modes, dofs: n });
+    }
+    let pattern = StiffnessPattern::new(scene);
+    let point = match options.linearization {
+        Linearization::Rest => scene.rest.clone(),
+        Linearization::Equilibrium => equilibrium(scene, &pattern, loads.gravity)?,
+    };
+    let mut stiffness = vec![0.0; pattern.nnz()];
+    pattern.add_tangent(scene, &point, 1.0, &mut stiffness);
+    let at_rest = options.linearization == Linearization::Rest;
+    let patterns = load_patterns(scene, loads);
+    let needs_load = options.selection == ModeSelection::Load || options.static_correction;
+    if needs_load && patterns.is_empty() {
+        return Err(PhysicsError::NoLoad);
+    }
+    let plain = options.selection == ModeSelection::Lowest && !options.static_correction;
+    let modes = if plain {
+        ModalBasis::lowest(scene, &pattern, &stiffness, n_modes)?
+    } else {
+        let statics = if options.static_correction { patterns.len().min(n_modes) } else { 0 };
+        let eigen = n_modes - statics;
+        // Candidates in the order they are wanted; a few more than needed
+        // stand in for static responses the modes already hold.
+        let spare = if options.static_correction { statics } else { 0 };
+        let candidates = match options.selection {
+            ModeSelection::Lowest => ModalBasis::lowest(scene, &pattern, &stiffness, (eigen + spare).min(n))?,
+            ModeSelection::Load => {
+                // Away from rest the run starts displaced from x* by x_rest - x*: its modal amplitudes count too.
+                let start: Option<Vec<f64>> = (!at_rest).then(|| (0..n).map(|k| scene.rest[k] - point[k]).collect());
+                ranked(scene, &pattern, &stiffness, &patterns, start.as_deref(), (eigen + spare).min(n))?
+            }
+        };
+        let columns = |b: &ModalBasis, j: usize| -> Vec<f64> { (0..n).map(|i| b.phi[i * b.r + j]).collect() };
+        let mut vectors: Vec<Vec<f64>> = (0..eigen.min(candidates.r)).map(|j| columns(&candidates, j)).collect();
+        if options.static_correction {
+            if at_rest {
+                let solver = ShiftedStiffness::new(scene, &pattern, &stiffness)?;
+                vectors.extend(patterns.iter().map(|f| solver.solve(f)));
+            } else {
+                // At the equilibrium the sag is known exactly: the displacement from rest.
+                vectors.push((0..n).map(|k| point[k] - scene.rest[k]).collect());
+            }
+            vectors.extend((eigen..candidates.r).map(|j| columns(&candidates, j)));
+        }
+        rayleigh_ritz(scene, &pattern, &stiffness, &vectors, n_modes)?
+    };
+    Ok(Basis { point, at_rest, pattern, stiffness, modes })
+}
+
+/// The `r` modes with the largest amplitude in the static response to the
+/// load patterns, |φ_iᵀ f| / λ_i, or in the displacement `start` the run
+/// begins with, |φ_iᵀ M u₀|; ascending in frequency.
+fn ranked(
+    scene: &Scene,
+    pattern: &StiffnessPattern,
+    stiffness: &[f64],
+    patterns: &[Vec<f64>],
+    start: Option<&[f64]>,
+    r: usize,
+) -> Result<ModalBasis, PhysicsError> {
+    let n = scene.n_dofs();
+    let all = if n <= DENSE_CANDIDATES {
+        ModalBasis::dense(scene, pattern, stiffness, n)?
+    } else {
+        load_ritz(scene, pattern, stiffness, patterns, start, (RITZ_FACTOR * r).max(r + RITZ_EXTRA).min(n))?
+    };
+    let lambda_floor = 1e-12 * all.lambda.iter().fold(0.0f64, |m, l| m.max(*l)).max(f64::MIN_POSITIVE);
+    let share = |j: usize| -> f64 {
+        let loaded =
+            patterns.iter().map(|f| (0..n).map(|i| all.phi[i * all.r + j] * f[i]).sum::<f64>().abs() / all.lambda[j].max(lambda_floor)).fold(0.0, f64::max);
+        let started = start.map_or(0.0, |u| (0..n).map(|i| all.phi[i * all.r + j] * scene.dof_mass[i] * u[i]).sum::<f64>().abs());
+        loaded.max(started)
+    };
+    let mut order: Vec<(f64, usize)> = (0..all.r).map(|j| (share(j), j)).collect();
+    order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    let mut keep: Vec<usize> = order.iter().take(r).map(|&(_, j)| j).collect();
+    keep.sort_unstable(); // ascending frequency, as the modes came
+    let mut phi = vec![0.0; n * keep.len()];
+    for i in 0..n {
+        for (c, &j) in keep.iter().enumerate() {
+            phi[i * keep.len() + c] = all.phi[i * all.r + j];
+        }
+    }
+    Ok(ModalBasis { n, r: keep.len(), lambda: keep.iter().map(|&j| all.lambda[j]).collect(), phi })
+}
+
+/// `m` Ritz pairs of the Krylov space of (K − σM)⁻¹ M grown from (K − σM)⁻¹ f
+/// for every load pattern f, and from the start displacement (σ a small
+/// negative shift, so the factor exists where K is singular).
+fn load_ritz(
+    scene: &Scene,
+    pattern: &StiffnessPattern,
+    stiffness: &[f64],
+    patterns: &[Vec<f64>],
+    start: Option<&[f64]>,
+    m: usize,
+) -> Result<ModalBasis, PhysicsError> {
+    let solver = ShiftedStiffness::new(scene, pattern, stiffness)?;
+    let mass = &scene.dof_mass;
+    let mut vectors: Vec<Vec<f64>> = Vec::new();
+    let mut block: Vec<Vec<f64>> = patterns.iter().map(|f| solver.solve(f)).collect();
+    block.extend(start.map(|u| u.to_vec()));
+    while vectors.len() < m && !block.is_empty() {
+        let mut next = Vec::new();
+        for v in block {
+            if let Some(q) = orthonormalized(&vectors, v, mass) {
+                let mq: Vec<f64> = q.iter().zip(mass).map(|(a, b)| a * b).collect();
+                next.push(solver.solve(&mq));
+                vectors.push(q);
+                if vectors.len() == m {
+                    break;
+                }
+            }
+        }
+        block = next;
+    }
+    let r = vectors.len();
+    rayleigh_ritz(scene, pattern, stiffness, &vectors, r)
+}
+
+/// `v` made M-orthogonal to the M-orthonormal `basis` (twice, for round-off)
+/// and M-normalized; `None` if nothing of it is left.
+fn orthonormalized(basis: &[Vec<f64>], mut v: Vec<f64>, mass: &[f64]) -> Option<Vec<f64>> {
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).zip(mass).map(|((x, y), m)| x * m * y).sum::<f64>();
+    let norm0 = dot(&v, &v).sqrt();
+    if !(norm0 > 0.0 && norm0.is_finite()) {
+        return None;
+    }
+    for _ in 0..2 {
+        for q in basis {
+            let c = dot(q, &v);
+            for (vi, qi) in v.iter_mut().zip(q) {
+                *vi -= c * qi;
+            }
+        }
+    }
+    let norm = dot(&v, &v).sqrt();
+    if norm <= DEPENDENT * norm0 {
+        return None;
+    }
+    v.iter_mut().for_each(|x| *x /= norm);
+    Some(v)
+}
+
+/// The first `r` independent directions of `vectors` (in their order),
+/// M-orthonormalized, then diagonalized in their span: Φ = Q Z with
+/// Zᵀ (Qᵀ K Q) Z = diag(λ), Zᵀ Z = I.
+fn rayleigh_ritz(scene: &Scene, pattern: &StiffnessPattern, stiffness: &[f64], vectors: &[Vec<f64>], r: usize) -> Result<ModalBasis, PhysicsError> {
+    let n = scene.n_dofs();
+    let mut q: Vec<Vec<f64>> = Vec::with_capacity(r);
+    for v in vectors {
+        if q.len() == r {
+            break;
+        }
+        if let Some(u) = orthonormalized(&q, v.clone(), &scene.dof_mass) {
+            q.push(u);
+        }
+    }
+    if q.len() < r {
+        return Err(PhysicsError::BasisDeficient { wanted: r, found: q.len() });
+    }
+    let mut kq = vec![0.0; n];
+    let mut kr = Mat::<f64>::zeros(r, r);
+    for j in 0..r {
+        pattern.sym_matvec(stiffness, &q[j], &mut kq);
+        for i in 0..r {
+            kr[(i, j)] = q[i].iter().zip(&kq).map(|(a, b)| a * b).sum::<f64>();
+        }
+    }
+    // Symmetrize the round-off away before the symmetric solver reads one triangle.
+    for j in 0..r {
+        for i in 0..j {
+            let s = 0.5 * (kr[(i, j)] + kr[(j, i)]);
+            kr[(i, j)] = s;
+            kr[(j, i)] = s;
+        }
+    }
+    let evd =
+        kr.self_adjoint_eigen(Side::Lower).map_err(|e| PhysicsError::LinearAlgebra { what: "Rayleigh-Ritz eigen decomposition", detail: format!("{e:?}") })?;
+    let (s, z) = (evd.S(), evd.U());
+    let lambda_max = (0..r).fold(0.0f64, |m, j| m.max(s[j].abs()));
+    let mut lambda = Vec::with_capacity(r);
+    for j in 0..r {
+        let l = s[j];
+        // Round-off around a zero eigenvalue may come out slightly negative.
+        let l = if l < 0.0 && l.abs() <= 1e-10 * lambda_max { 0.0 } else { l };
+        if !(l >= 0.0) {
+            return Err(PhysicsError::NegativeEigenvalue { lambda: l });
+        }
+        lambda.push(l);
+    }
+    let mut phi = vec![0.0; n * r];
+    for i in 0..n {
+        for j in 0..r {
+            phi[i * r + j] = (0..r).map(|c| q[c][i] * z[(c, j)]).sum::<f64>();
+        }
+    }
+    Ok(ModalBasis { n, r, lambda, phi })
+}
+
+/// Solves with K − σM, σ a small negative shift (so a singular K factors;
+/// the solution differs from K⁺f by a relative σ/λ_min).
+struct ShiftedStiffness {
+    llt: faer::sparse::linalg::solvers::Llt<usize, f64>,
+}
+
+impl ShiftedStiffness {
+    fn new(scene: &Scene, pattern: &StiffnessPattern, stiffness: &[f64]) -> Result<Self, PhysicsError> {
+        let n = scene.n_dofs();
+        let diag_max = pattern.diag.iter().enumerate().fold(0.0f64, |m, (k, &p)| m.max(stiffness[p] / scene.dof_mass[k]));
+        let sigma = -1e-9 * diag_max;
+        let mut vals = stiffness.to_vec();
+        for (k, &p) in pattern.diag.iter().enumerate() {
+            vals[p] -= sigma * scene.dof_mass[k];
+        }
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx);
+        let llt = SparseColMatRef::new(sym, &vals)
+            .sp_cholesky(Side::Upper)
+            .map_err(|e| PhysicsError::LinearAlgebra { what: "sparse Cholesky factorization of the stiffness", detail: format!("{e:?}") })?;
+        Ok(ShiftedStiffness { llt })
+    }
+
+    fn solve(&self, f: &[f64]) -> Vec<f64> {
+        let mut x = faer::Col::<f64>::from_fn(f.len(), |i| f[i]);
+        faer::linalg::solvers::Solve::solve_in_place(&self.llt, x.as_mat_mut());
+        x.iter().copied().collect()
+    }
+}
