@@ -312,6 +312,42 @@ fn extremes() -> Vec<Extreme> {
             gravity: None,
             compare: false,
         },
+        Extreme {
+            label: "modes of the loads with a static correction (modeSelection load, staticCorrection true), 1 s",
+            applies: all,
+            set: |_| vec![(vr::MODE_SELECTION, I(2)), (vr::STATIC_CORRECTION, B(true))],
+            t_end: one_second,
+            steps: &[0.01],
+            gravity: None,
+            compare: true,
+        },
+        Extreme {
+            label: "linearized at the equilibrium under gravity (linearization equilibrium, modeSelection load, staticCorrection true), 1 s",
+            applies: all,
+            set: |_| vec![(vr::LINEARIZATION, I(2)), (vr::MODE_SELECTION, I(2)), (vr::STATIC_CORRECTION, B(true))],
+            t_end: one_second,
+            steps: &[0.01],
+            gravity: None,
+            compare: true,
+        },
+        Extreme {
+            label: "linearized at the equilibrium under gravity 1e4 m/s² along -y, 0.2 s",
+            applies: all,
+            set: |_| vec![(vr::LINEARIZATION, I(2)), (vr::GRAVITY, F(vec![0.0, -1e4, 0.0]))],
+            t_end: |_, _| 0.2,
+            steps: &[0.01],
+            gravity: None,
+            compare: false,
+        },
+        Extreme {
+            label: "modes of the loads without a load (modeSelection load, gravity 0)",
+            applies: all,
+            set: |_| vec![(vr::MODE_SELECTION, I(2)), (vr::GRAVITY, F(vec![0.0, 0.0, 0.0]))],
+            t_end: one_second,
+            steps: &[0.01],
+            gravity: None,
+            compare: false,
+        },
     ]
 }
 
@@ -332,6 +368,9 @@ const PARAMETERS: &[&str] = &[
     "reduction",
     "integrator",
     "gravity",
+    "modeSelection",
+    "staticCorrection",
+    "linearization",
 ];
 
 #[derive(Clone, Debug, PartialEq)]
