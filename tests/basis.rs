@@ -227,3 +227,41 @@ fn a_basis_from_the_loads_needs_a_load() {
     assert_eq!(f.set_f64(vr::GRAVITY, &[0.0, -9.81, 0.0]), OK);
     assert_eq!(unsafe { fmi3ExitInitializationMode(f.inst) }, OK, "{:?}", f.messages());
 }
+
+#[test]
+fn force_residual_rises_when_the_scene_leaves_the_basis() {
+    // Eight modes chosen for gravity along -y, with its static response.
+    let f = Fmu::new();
+    assert_eq!(f.set_u64(vr::N_MODES, 8), OK);
+    assert_eq!(f.set_i64(vr::MODE_SELECTION, 2), OK);
+    let on: bool = true;
+    assert_eq!(unsafe { modal_mass_spring::fmi::exports::fmi3SetBoolean(f.inst, &vr::STATIC_CORRECTION, 1, &on, 1) }, OK);
+    f.init();
+    let residual = |f: &Fmu| f.f64s(vr::FORCE_RESIDUAL, 1)[0];
+    let mut inside = 0.0f64;
+    for _ in 0..100 {
+        assert_eq!(f.step(f.time(), 0.01), OK, "{:?}", f.messages());
+        inside = inside.max(residual(&f));
+    }
+    assert!(inside < 0.5, "forceResidual within the basis's range: {inside}");
+    // Gravity turned sideways: the modes cannot follow it.
+    assert_eq!(f.set_f64(vr::GRAVITY, &[19.62, -9.81, 0.0]), OK);
+    let mut statuses = Vec::new();
+    let mut outside = 0.0f64;
+    for _ in 0..100 {
+        statuses.push(f.step(f.time(), 0.01));
+        outside = outside.max(residual(&f));
+    }
+    assert!(outside > 0.7, "forceResidual with sideways gravity: {outside}");
+    // The first step past forceResidualLimit returns fmi3Warning, once, and says why.
+    assert_eq!(statuses.iter().filter(|&&s| s == WARNING).count(), 1, "{statuses:?}");
+    assert!(statuses.iter().all(|&s| s == OK || s == WARNING));
+    let warned: Vec<String> = f.log.take().into_iter().filter(|(s, _, _)| *s == WARNING).map(|(_, _, m)| m).collect();
+    assert!(warned.len() == 1 && warned[0].contains("forceResidual") && warned[0].contains("forceResidualLimit"), "{warned:?}");
+    // Full space represents every force.
+    let full = Fmu::new();
+    assert_eq!(full.set_i64(vr::REDUCTION, 2), OK);
+    full.init();
+    full.run(10, 0.01);
+    assert_eq!(residual(&full), 0.0);
+}

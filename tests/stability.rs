@@ -375,9 +375,20 @@ const PARAMETERS: &[&str] = &[
 
 #[derive(Clone, Debug, PartialEq)]
 enum Outcome {
-    Stable { drift: f64, stretch: f64 },
-    Refused { parameter: String, message: String },
-    Discarded { time: f64, message: String },
+    /// `warned`: the time of the step that returned fmi3Warning (forceResidual passed its limit).
+    Stable {
+        drift: f64,
+        stretch: f64,
+        warned: Option<f64>,
+    },
+    Refused {
+        parameter: String,
+        message: String,
+    },
+    Discarded {
+        time: f64,
+        message: String,
+    },
     NotApplicable,
 }
 
@@ -465,6 +476,7 @@ fn run_cell(e: &Extreme, s: &SceneDef, modal: bool, implicit: bool) -> Cell {
     let t_end = (e.t_end)(s, implicit);
     let mut samples = Vec::new();
     let (mut e0, mut k_max, mut drift, mut max_stretch) = (energy(&f), 0.0f64, 0.0f64, 0.0f64);
+    let mut warned = None;
     let mut gravity = e.gravity.map(|g| g(0.0));
     if let Some(g) = gravity {
         assert_eq!(f.set_f64(vr::GRAVITY, &g), OK);
@@ -492,7 +504,14 @@ fn run_cell(e: &Extreme, s: &SceneDef, modal: bool, implicit: bool) -> Cell {
             assert!(!message.is_empty(), "a discarded step logged no reason");
             return Cell { outcome: Outcome::Discarded { time: t, message }, samples, initial };
         }
-        assert_eq!(status, OK, "{} {} at t = {t}: {:?}", s.name, e.label, f.messages());
+        if status == WARNING {
+            let message = f.log.0.lock().unwrap().last().map(|(_, _, m)| m.clone()).unwrap_or_default();
+            assert!(message.contains("forceResidual"), "{} {}: a warning without its reason: {message}", s.name, e.label);
+            assert!(warned.is_none(), "{} {}: warned twice", s.name, e.label);
+            warned = Some(t);
+        } else {
+            assert_eq!(status, OK, "{} {} at t = {t}: {:?}", s.name, e.label, f.messages());
+        }
         let p = f.positions();
         let v = f.f64s(vr::VELOCITIES, p.len());
         let q = f.f64s(vr::MODAL_COORDINATES, r);
@@ -509,7 +528,7 @@ fn run_cell(e: &Extreme, s: &SceneDef, modal: bool, implicit: bool) -> Cell {
             samples.push(p);
         }
     }
-    Cell { outcome: Outcome::Stable { drift, stretch: max_stretch }, samples, initial }
+    Cell { outcome: Outcome::Stable { drift, stretch: max_stretch, warned }, samples, initial }
 }
 
 /// E of docs/method.md, section 6 (equal node masses cancel).
@@ -576,8 +595,11 @@ fn stability_matrix() {
                 let x = cell(ei, si, c);
                 let mut text = short(&x.outcome);
                 match &x.outcome {
-                    Outcome::Stable { drift, stretch } => {
+                    Outcome::Stable { drift, stretch, warned } => {
                         text += &format!(" · drift {drift:.1e}");
+                        if let Some(t) = warned {
+                            text += &format!(" · forceResidual warning at {t:.2} s");
+                        }
                         if e.compare {
                             text += &format!(" · stretch {:.0} %", stretch * 100.0);
                             let full = cell(ei, si, c + 2);

@@ -67,7 +67,9 @@ fn record(scene: &str, modes: u64, reduction: i64, integrator: i64) -> String {
             assert_eq!(f.set_f64(vr::GRAVITY, &[-1.0, -9.81, 2.0]), OK, "{:?}", f.messages());
             assert_eq!(f.set_f64(vr::MODE_WEIGHTS, &weights(r, &[1.0])), OK, "{:?}", f.messages());
         }
-        assert_eq!(f.step(f.time(), H), OK, "{scene} {reduction} {integrator}: {:?}", f.messages());
+        // fmi3Warning: a completed step whose forceResidual passed its limit.
+        let status = f.step(f.time(), H);
+        assert!(status == OK || status == WARNING, "{scene} {reduction} {integrator}: {:?}", f.messages());
         let o = f.outputs();
         let energies = &o[o.len() - 2..];
         let _ = writeln!(out, "{scene} {reduction} {integrator} {k} {:016x} {:016x} {:016x}", fnv(&o), energies[0], energies[1]);

@@ -111,7 +111,7 @@ fuzz_target!(|data: &[u8]| {
             let t = time(inst);
             let (mut a, mut b, mut c, mut last) = (false, false, false, 0.0);
             let step = checked(inst, env, "fmi3DoStep", true, &mut || unsafe { f.fmi3DoStep(inst, t, 1e-4, false, &mut a, &mut b, &mut c, &mut last) });
-            if step == OK {
+            if step == OK || step == WARNING {
                 assert!(outputs(inst).is_some(), "outputs refused after a successful step");
             }
         }

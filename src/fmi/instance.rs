@@ -11,8 +11,8 @@ use super::logging::Logger;
 use super::model::Params;
 use super::registry::INSTANCE_MAGIC;
 use super::state_machine::{same_time, Mode};
-use super::variables::{Causality, VARIABLES};
-use super::{DISCARD, OK};
+use super::variables::{vr, Causality, VARIABLES};
+use super::{DISCARD, OK, WARNING};
 use crate::physics::Simulator;
 
 type R = Result<fmi3Status, fmi3Status>;
@@ -34,6 +34,8 @@ pub struct Instance {
     pub(super) stop_time: Option<f64>,
     /// FMU states made by this instance and not freed yet.
     pub(super) states: OwnedStates,
+    /// forceResidual passed forceResidualLimit once, and the host was told.
+    pub(super) residual_warned: bool,
 }
 
 impl Instance {
@@ -50,6 +52,7 @@ impl Instance {
             start_time: 0.0,
             stop_time: None,
             states: OwnedStates::default(),
+            residual_warned: false,
         }
     }
 
@@ -117,6 +120,19 @@ impl Instance {
             Ok(()) => {
                 let end = self.start_time + sim.time();
                 unsafe { *last_successful_time = end };
+                let (residual, limit) = (sim.force_residual(), self.params.scalar(vr::FORCE_RESIDUAL_LIMIT));
+                if residual > limit && !self.residual_warned {
+                    self.residual_warned = true;
+                    self.log.log(
+                        WARNING,
+                        &format!(
+                            "{F}: at t = {end} forceResidual = {residual:.3} passed forceResidualLimit = {limit}: the modal basis holds \
+                             too little of the force at this state; the results may leave the full-space model (more modes, \
+                             modeSelection = load, or reduction = full)"
+                        ),
+                    );
+                    return Ok(WARNING);
+                }
                 Ok(OK)
             }
             Err(e) => {

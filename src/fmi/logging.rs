@@ -31,9 +31,9 @@ impl Logger {
             ERROR => "logStatusError",
             _ => "logStatusFatal",
         };
-        // Failures (discarded steps, errors) always reach the host with their
-        // reason; the rest only when asked for.
-        let enabled = status >= DISCARD || (self.on && (self.category_on(category) || self.category_on("logAll")));
+        // Every status but fmi3OK (warnings, discarded steps, errors) reaches
+        // the host with its reason; the rest only when asked for.
+        let enabled = status >= WARNING || (self.on && (self.category_on(category) || self.category_on("logAll")));
         if enabled {
             log_raw(self.env, self.callback, status, category, message);
         }

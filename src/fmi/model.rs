@@ -184,6 +184,7 @@ pub fn computed(sim: &Simulator, vr: u32, time0: f64) -> Computed<'_> {
         vr::KINETIC_ENERGY => Computed::Scalar(sim.kinetic_energy()),
         vr::POTENTIAL_ENERGY => Computed::Scalar(sim.potential_energy()),
         vr::MODE_FREQUENCIES => Computed::Array(sim.mode_frequencies()),
+        vr::FORCE_RESIDUAL => Computed::Scalar(sim.force_residual()),
         _ => unreachable!("value reference {vr} is not computed"),
     }
 }

@@ -115,6 +115,7 @@ impl Instance {
         self.stale = true;
         self.start_time = 0.0;
         self.stop_time = None;
+        self.residual_warned = false;
         Ok(OK)
     }
 }

@@ -59,6 +59,8 @@ pub struct Outputs {
     pub kinetic: f64,
     /// Elastic energy plus gravity potential relative to rest [J].
     pub potential: f64,
+    /// The part of the force the space cannot represent, relative to the load.
+    pub force_residual: f64,
 }
 
 impl Outputs {
@@ -71,6 +73,7 @@ impl Outputs {
             modal_coordinates: vec![0.0; modes],
             kinetic: 0.0,
             potential: 0.0,
+            force_residual: 0.0,
         }
     }
 }
@@ -151,6 +154,7 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
             _ => to_node_order::<3>(&scene.slot_of_node, scene.n_free, x, &out.dof_velocities, &mut out.positions, &mut out.velocities),
         }
         out.potential = space.elastic_energy(&state.y, &mut self.work) + space.gravity_potential(loads, &state.y, &self.work);
+        out.force_residual = space.force_residual(loads, &state.y, &mut self.work);
     }
 }
 

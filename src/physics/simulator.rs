@@ -232,6 +232,11 @@ impl Simulator {
     pub fn potential_energy(&self) -> f64 {
         self.outputs.potential
     }
+    /// The part of the physical force the basis cannot represent, relative
+    /// to the load (0 in full space).
+    pub fn force_residual(&self) -> f64 {
+        self.outputs.force_residual
+    }
     pub fn loads(&self) -> &Loads {
         &self.loads
     }

@@ -17,6 +17,7 @@ use modal_mass_spring::fmi::state_machine::Mode;
 use modal_mass_spring::fmi::variables::{vr, INSTANTIATION_TOKEN};
 
 pub const OK: fmi3Status = fmi3Status_fmi3OK;
+pub const WARNING: fmi3Status = fmi3Status_fmi3Warning;
 pub const DISCARD: fmi3Status = fmi3Status_fmi3Discard;
 pub const ERROR: fmi3Status = fmi3Status_fmi3Error;
 pub const FATAL: fmi3Status = fmi3Status_fmi3Fatal;
@@ -124,17 +125,20 @@ impl Fmu {
     pub fn step(&self, t: f64, h: f64) -> fmi3Status {
         let (mut a, mut b, mut c, mut last) = (true, true, true, f64::NAN);
         let s = unsafe { fmi3DoStep(self.inst, t, h, false, &mut a, &mut b, &mut c, &mut last) };
-        if s == OK {
+        if s == OK || s == WARNING {
             assert!(!a && !b && !c);
             assert!((last - (t + h)).abs() < 1e-12, "lastSuccessfulTime {last}");
         }
         s
     }
 
+    /// `n` steps of `h`, each of which must complete (fmi3OK, or fmi3Warning
+    /// when forceResidual passes its limit).
     pub fn run(&self, n: usize, h: f64) {
         for _ in 0..n {
             let t = self.time();
-            assert_eq!(self.step(t, h), OK, "{:?}", self.messages());
+            let s = self.step(t, h);
+            assert!(s == OK || s == WARNING, "{s}: {:?}", self.messages());
         }
     }
 

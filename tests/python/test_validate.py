@@ -26,6 +26,10 @@ INTERFACE = {
     "fixedNodes": ("Enumeration", "parameter", "fixed"),
     "reduction": ("Enumeration", "parameter", "fixed"),
     "integrator": ("Enumeration", "parameter", "fixed"),
+    "modeSelection": ("Enumeration", "parameter", "fixed"),
+    "staticCorrection": ("Boolean", "parameter", "fixed"),
+    "linearization": ("Enumeration", "parameter", "fixed"),
+    "forceResidualLimit": ("Float64", "parameter", "tunable"),
     "gravity": ("Float64", "parameter", "tunable"),
     "dampingAlpha": ("Float64", "parameter", "tunable"),
     "dampingBeta": ("Float64", "parameter", "tunable"),
@@ -35,6 +39,7 @@ INTERFACE = {
     "modalCoordinates": ("Float64", "output", "continuous"),
     "kineticEnergy": ("Float64", "output", "continuous"),
     "potentialEnergy": ("Float64", "output", "continuous"),
+    "forceResidual": ("Float64", "output", "continuous"),
     "modeFrequencies": ("Float64", "calculatedParameter", "fixed"),
 }
 
@@ -42,6 +47,8 @@ ENUMERATIONS = {
     "fixedNodes": ["top-row", "top-corners"],
     "reduction": ["modal", "full"],
     "integrator": ["newmark-explicit", "newmark-implicit"],
+    "modeSelection": ["lowest", "load"],
+    "linearization": ["rest", "equilibrium"],
 }
 
 # array variables and the structural parameters (or fixed sizes) of their dimensions

@@ -291,6 +291,11 @@ impl Space for Full {
         out.copy_from_slice(v);
     }
 
+    /// Every force is represented: 0.
+    fn force_residual(&self, _loads: &Loads, _u: &[f64], _w: &mut FullWork) -> f64 {
+        0.0
+    }
+
     /// q = Phi^T M (x - x*) on the reported modes.
     fn modal_coordinates(&self, u: &[f64], out: &mut [f64]) {
         if let Some(b) = &self.reported {

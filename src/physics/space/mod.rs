@@ -88,6 +88,9 @@ pub trait Space: Send + Sized + 'static {
     fn dof_velocities(&self, v: &[f64], out: &mut [f64]);
     /// Coordinates of the kept or reported modes at y.
     fn modal_coordinates(&self, y: &[f64], out: &mut [f64]);
+    /// The part of the physical force at y the space cannot represent,
+    /// relative to the load (`docs/method.md`, section 6); 0 in full space.
+    fn force_residual(&self, loads: &Loads, y: &[f64], w: &mut Self::Work) -> f64;
 }
 
 /// The registry of spaces: builds the space `solver.reduction` names on

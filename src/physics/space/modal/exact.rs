@@ -60,4 +60,8 @@ impl ReducedForce for Exact {
     fn elastic_energy(&self, _scene: &Scene, _modes: &Modes, _q: &[f64], w: &mut ExactWork) -> f64 {
         w.elastic
     }
+
+    fn spring_forces<'w>(&self, _scene: &Scene, _modes: &Modes, _q: &[f64], w: &'w mut ExactWork) -> &'w [f64] {
+        &w.f
+    }
 }

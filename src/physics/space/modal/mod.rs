@@ -53,6 +53,9 @@ pub trait ReducedForce: Send + Sized + 'static {
     fn positions<'w>(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &'w mut Self::Work) -> &'w [f64];
     /// Elastic energy of every spring at `q`, the coordinates of the last [`Self::project`] [J].
     fn elastic_energy(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &mut Self::Work) -> f64;
+    /// The exact spring forces of every spring on the free DOFs at `q`, the
+    /// coordinates of the last [`Self::project`] (for the error indicator).
+    fn spring_forces<'w>(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &'w mut Self::Work) -> &'w [f64];
 }
 
 /// The kept modes, in the two layouts the loops want, and the point x*
@@ -128,6 +131,9 @@ pub struct ModalWork<W> {
     force: W,
     /// Reduced tangent Phi^T K(x) Phi (column-major).
     kr: Vec<f64>,
+    /// The total force on the free DOFs and its generalized force, for the error indicator.
+    total: Vec<f64>,
+    generalized: Vec<f64>,
     /// Newton matrix, LU-factored in place, with its row permutation.
     jac: Mat<f64>,
     perm: Vec<usize>,
@@ -184,6 +190,8 @@ impl<F: ReducedForce> Space for Modal<F> {
             gravity_offset: 0.0,
             force: self.force.work(&self.scene, &self.modes),
             kr: vec![0.0; r * r],
+            total: vec![0.0; self.modes.basis.n],
+            generalized: vec![0.0; r],
             jac: Mat::zeros(r, r),
             perm: vec![0; r],
             perm_inv: vec![0; r],
@@ -300,6 +308,36 @@ impl<F: ReducedForce> Space for Modal<F> {
             modal
         } else {
             w.gravity_offset + modal
+        }
+    }
+
+    /// The part of the physical force at q that the basis cannot hold,
+    /// relative to the load: with f = f_springs(x) + M g and F = Phi^T f,
+    /// r = f - M Phi F, and ||r|| / ||M g|| in the M^-1 norm (||M g|| = the
+    /// weight; the spring forces' norm where gravity is zero).
+    fn force_residual(&self, loads: &Loads, q: &[f64], w: &mut Self::Work) -> f64 {
+        let (n, r, d) = (self.modes.basis.n, self.modes.basis.r, self.scene.dim);
+        let mass = &self.scene.dof_mass;
+        let springs = self.force.spring_forces(&self.scene, &self.modes, q, &mut w.force);
+        let (mut load, mut spring) = (0.0, 0.0);
+        for k in 0..n {
+            let g = mass[k] * loads.gravity[k % d];
+            load += g * g / mass[k];
+            spring += springs[k] * springs[k] / mass[k];
+            w.total[k] = springs[k] + g;
+        }
+        self.modes.project(&w.total, &mut w.generalized);
+        let mut residual = 0.0;
+        for k in 0..n {
+            let held: f64 = (0..r).map(|j| self.modes.basis.phi[k * r + j] * w.generalized[j]).sum();
+            let rk = w.total[k] - mass[k] * held;
+            residual += rk * rk / mass[k];
+        }
+        let scale = if load > 0.0 { load } else { spring };
+        if scale > 0.0 {
+            (residual / scale).sqrt()
+        } else {
+            0.0
         }
     }
 
