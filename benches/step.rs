@@ -94,7 +94,8 @@ fn do_step(c: &mut Criterion) {
             let t = Instant::now();
             for _ in 0..iters {
                 let status = unsafe { fmi3DoStep(inst, time, dt, true, &mut event, &mut terminate, &mut early, &mut last) };
-                assert_eq!(status, fmi3Status_fmi3OK);
+                // fmi3Warning once, when forceResidual passes its limit in the long undamped swing.
+                assert!(status == fmi3Status_fmi3OK || status == fmi3Status_fmi3Warning);
                 time += dt;
             }
             t.elapsed()

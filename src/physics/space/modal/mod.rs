@@ -117,6 +117,8 @@ pub struct Modal<F: ReducedForce = Exact> {
     omega_sq_bound: f64,
     /// The modal coordinate of a one-length-scale displacement of the whole mass.
     newton_scale: f64,
+    /// 1 / m_k per free DOF.
+    inv_mass: Vec<f64>,
 }
 
 /// Load terms and scratch of a modal run.
@@ -131,9 +133,10 @@ pub struct ModalWork<W> {
     force: W,
     /// Reduced tangent Phi^T K(x) Phi (column-major).
     kr: Vec<f64>,
-    /// The total force on the free DOFs and its generalized force, for the error indicator.
-    total: Vec<f64>,
+    /// F = Phi^T (f + M g) of the last force evaluation, before the weights (for the error indicator).
     generalized: Vec<f64>,
+    /// ||M g||^2 in the M^-1 norm, the weight's scale of the error indicator.
+    load_scale: f64,
     /// Newton matrix, LU-factored in place, with its row permutation.
     jac: Mat<f64>,
     perm: Vec<usize>,
@@ -152,7 +155,8 @@ impl<F: ReducedForce> Modal<F> {
         let frequencies = basis.frequencies();
         let modes = Modes::new(basis, built.point, built.at_rest);
         let force = F::new(&scene, &modes)?;
-        Ok(Modal { force, frequencies, omega_sq_bound, newton_scale, modes, scene })
+        let inv_mass = scene.dof_mass.iter().map(|m| 1.0 / m).collect();
+        Ok(Modal { force, frequencies, omega_sq_bound, newton_scale, inv_mass, modes, scene })
     }
 
     /// The kept modes.
@@ -190,8 +194,8 @@ impl<F: ReducedForce> Space for Modal<F> {
             gravity_offset: 0.0,
             force: self.force.work(&self.scene, &self.modes),
             kr: vec![0.0; r * r],
-            total: vec![0.0; self.modes.basis.n],
             generalized: vec![0.0; r],
+            load_scale: 0.0,
             jac: Mat::zeros(r, r),
             perm: vec![0; r],
             perm_inv: vec![0; r],
@@ -218,8 +222,10 @@ impl<F: ReducedForce> Space for Modal<F> {
         }
         w.gravity.fill(0.0);
         w.gravity_offset = 0.0;
+        w.load_scale = 0.0;
         for k in 0..n {
             let fk = self.scene.dof_mass[k] * loads.gravity[k % d];
+            w.load_scale += fk * loads.gravity[k % d];
             for j in 0..r {
                 w.gravity[j] += self.modes.basis.phi[k * r + j] * fk;
             }
@@ -233,6 +239,7 @@ impl<F: ReducedForce> Space for Modal<F> {
         for (hj, gj) in h.iter_mut().zip(&w.gravity) {
             *hj += gj;
         }
+        w.generalized.copy_from_slice(h);
         // weights act on everything but the mode's own linear spring
         for (j, hj) in h.iter_mut().enumerate() {
             let wj = loads.mode_weights[j];
@@ -313,29 +320,24 @@ impl<F: ReducedForce> Space for Modal<F> {
 
     /// The part of the physical force at q that the basis cannot hold,
     /// relative to the load: with f = f_springs(x) + M g and F = Phi^T f,
-    /// r = f - M Phi F, and ||r|| / ||M g|| in the M^-1 norm (||M g|| = the
-    /// weight; the spring forces' norm where gravity is zero).
+    /// r = f - M Phi F, and ||r|| / ||M g|| in the M^-1 norm (the spring
+    /// forces' norm where gravity is zero). Since Phi^T M Phi = I, r is
+    /// M^-1-orthogonal to M Phi F and ||r||^2 = ||f||^2 - |F|^2: one pass over
+    /// the free DOFs, with F kept from the last force evaluation.
     fn force_residual(&self, loads: &Loads, q: &[f64], w: &mut Self::Work) -> f64 {
-        let (n, r, d) = (self.modes.basis.n, self.modes.basis.r, self.scene.dim);
-        let mass = &self.scene.dof_mass;
+        let d = self.scene.dim;
+        let (mass, inv_mass) = (&self.scene.dof_mass, &self.inv_mass);
         let springs = self.force.spring_forces(&self.scene, &self.modes, q, &mut w.force);
-        let (mut load, mut spring) = (0.0, 0.0);
-        for k in 0..n {
-            let g = mass[k] * loads.gravity[k % d];
-            load += g * g / mass[k];
-            spring += springs[k] * springs[k] / mass[k];
-            w.total[k] = springs[k] + g;
+        let (mut total, mut spring) = (0.0, 0.0);
+        for (k, fk) in springs.iter().enumerate() {
+            let t = fk + mass[k] * loads.gravity[k % d];
+            total += t * t * inv_mass[k];
+            spring += fk * fk * inv_mass[k];
         }
-        self.modes.project(&w.total, &mut w.generalized);
-        let mut residual = 0.0;
-        for k in 0..n {
-            let held: f64 = (0..r).map(|j| self.modes.basis.phi[k * r + j] * w.generalized[j]).sum();
-            let rk = w.total[k] - mass[k] * held;
-            residual += rk * rk / mass[k];
-        }
-        let scale = if load > 0.0 { load } else { spring };
+        let held: f64 = w.generalized.iter().map(|f| f * f).sum();
+        let scale = if w.load_scale > 0.0 { w.load_scale } else { spring };
         if scale > 0.0 {
-            (residual / scale).sqrt()
+            ((total - held).max(0.0) / scale).sqrt()
         } else {
             0.0
         }
