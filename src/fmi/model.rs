@@ -4,8 +4,8 @@
 //! [`super`].
 
 use super::variables::{index_of, vr, Dim, Variability, Variable, SCENES, VARIABLES};
-use crate::options::{FixedNodes, Integrator, Linearization, ModeSelection, Reduction};
-use crate::physics::{BasisOptions, Grid, Loads, PhysicsError, Simulator, SolverParams};
+use crate::options::{FixedNodes, ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction};
+use crate::physics::{BasisOptions, ForceOptions, Grid, Loads, PhysicsError, Simulator, SolverParams};
 
 /// Current values of the parameters and inputs, indexed like [`VARIABLES`]
 /// (empty for the other variables). Booleans are 0/1, integers exact
@@ -146,6 +146,10 @@ impl Params {
                 selection: self.enumeration(vr::MODE_SELECTION, ModeSelection::from_value),
                 static_correction: self.scalar(vr::STATIC_CORRECTION) != 0.0,
                 linearization: self.enumeration(vr::LINEARIZATION, Linearization::from_value),
+            },
+            force: ForceOptions {
+                evaluation: self.enumeration(vr::FORCE_EVALUATION, ForceEvaluation::from_value),
+                cubature_tolerance: self.scalar(vr::CUBATURE_TOLERANCE),
             },
             max_internal_step: self.scalar(vr::MAX_INTERNAL_STEP),
             substepping: true,

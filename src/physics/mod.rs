@@ -37,5 +37,5 @@ pub use grid::{FixedNodes, Grid};
 pub use integrator::{Integrator, EXPLICIT_SAFETY};
 pub use scene::Scene;
 pub use simulator::{internal_step_count, Simulator, SolverParams, MAX_INTERNAL_STEPS_PER_CALL, STEP_COUNT_TOLERANCE};
-pub use space::Reduction;
+pub use space::{ForceEvaluation, ForceOptions, Reduction};
 pub use state::{Loads, Snapshot, State};

@@ -11,7 +11,7 @@ use super::engine::{Outputs, Stepper};
 use super::error::{positive, Expected, PhysicsError, Quantity, StepFailure};
 use super::integrator::Integrator;
 use super::scene::Scene;
-use super::space::{self, Reduction};
+use super::space::{self, ForceOptions, Reduction};
 use super::state::{Loads, Snapshot, State};
 
 /// How a scene is integrated.
@@ -26,6 +26,8 @@ pub struct SolverParams {
     pub n_modes: usize,
     /// How the modes are chosen (`docs/method.md`, section 3).
     pub basis: BasisOptions,
+    /// How the modal space evaluates the projected spring force (`docs/method.md`, section 4).
+    pub force: ForceOptions,
     /// Upper bound on one internal step [s].
     pub max_internal_step: f64,
     /// Split a communication step into internal steps that keep the
@@ -36,7 +38,7 @@ pub struct SolverParams {
 impl SolverParams {
     /// `n_modes` modes, the given space and scheme, internal steps of at most 10 ms.
     pub fn new(reduction: Reduction, integrator: Integrator, n_modes: usize) -> Self {
-        SolverParams { reduction, integrator, n_modes, basis: BasisOptions::default(), max_internal_step: 0.01, substepping: true }
+        SolverParams { reduction, integrator, n_modes, basis: BasisOptions::default(), force: ForceOptions::default(), max_internal_step: 0.01, substepping: true }
     }
 }
 

@@ -33,7 +33,23 @@ use super::integrator;
 use super::scene::Scene;
 use super::simulator::SolverParams;
 use super::state::Loads;
-pub use crate::options::Reduction;
+pub use crate::options::{ForceEvaluation, Reduction};
+
+/// How the modal space evaluates the projected spring force (`docs/method.md`, section 4).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ForceOptions {
+    pub evaluation: ForceEvaluation,
+    /// With [`ForceEvaluation::Cubature`]: the relative error of Phi^T f on
+    /// the training and held-out poses the cubature set is grown to reach.
+    pub cubature_tolerance: f64,
+}
+
+impl Default for ForceOptions {
+    /// The paper's: every spring.
+    fn default() -> Self {
+        ForceOptions { evaluation: ForceEvaluation::Exact, cubature_tolerance: 0.01 }
+    }
+}
 
 /// The equations of one space; see the module documentation.
 pub trait Space: Send + Sized + 'static {
