@@ -58,7 +58,7 @@ fn main() {
         max_internal_step: h,
         substepping: true,
         basis: BasisOptions::default(),
-    force: ForceOptions::default(),
+        force: ForceOptions::default(),
     };
     let reference_h = 1e-4;
     let reference = simulate(&p, &full(Integrator::NewmarkImplicit, reference_h), reference_h, 100, frames).unwrap();
@@ -78,7 +78,7 @@ fn main() {
                 max_internal_step: h,
                 substepping: true,
                 basis: BasisOptions::default(),
-            force: ForceOptions::default(),
+                force: ForceOptions::default(),
             });
         }
         rows.push(full(integrator, h));

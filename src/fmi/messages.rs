@@ -23,6 +23,7 @@ pub fn variable(q: Quantity) -> &'static str {
         Quantity::DampingBeta => "dampingBeta",
         Quantity::ModeWeights => "modeWeights",
         Quantity::StepSize => "communicationStepSize",
+        Quantity::CubatureTolerance => "cubatureTolerance",
     }
 }
 
@@ -93,6 +94,14 @@ pub fn describe(e: &PhysicsError, p: &Params) -> String {
             integrator(Integrator::NewmarkImplicit)
         ),
         StepFailed { time, cause } => format!("step from t = {time} s failed: {}", failure(cause)),
+        CubatureNotReached { tolerance, reached, springs } => format!(
+            "forceEvaluation = cubature: the cubature set reached a relative force error of {reached:.3e} with {springs} springs \
+             and no spring left improves it, cubatureTolerance = {tolerance:e}; raise cubatureTolerance or use forceEvaluation = exact"
+        ),
+        CubatureTrainingDiverged { time } => format!(
+            "forceEvaluation = cubature: the exact reduced run under gravity that makes the training poses diverged at t = {time} s; \
+             use forceEvaluation = exact"
+        ),
         SnapshotLength { len, expected } => format!("the state holds {len} values per array, this scene needs {expected}"),
         SnapshotNotFinite => "the state holds non-finite values".into(),
     }

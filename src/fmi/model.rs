@@ -189,6 +189,7 @@ pub fn computed(sim: &Simulator, vr: u32, time0: f64) -> Computed<'_> {
         vr::POTENTIAL_ENERGY => Computed::Scalar(sim.potential_energy()),
         vr::MODE_FREQUENCIES => Computed::Array(sim.mode_frequencies()),
         vr::FORCE_RESIDUAL => Computed::Scalar(sim.force_residual()),
+        vr::CUBATURE_SPRINGS => Computed::Scalar(sim.cubature_springs() as f64),
         _ => unreachable!("value reference {vr} is not computed"),
     }
 }

@@ -21,6 +21,8 @@ pub trait Stepper: Send {
     fn kept_modes(&self) -> Option<usize>;
     /// Frequencies of the kept or reported modes [rad/s].
     fn frequencies(&self) -> &[f64];
+    /// Springs one force evaluation visits.
+    fn springs(&self) -> usize;
     /// Longest stable internal step under `loads`, if stability limits it.
     fn stable_step(&self, loads: &Loads) -> Option<f64>;
     /// Squared-frequency bound of the integrated system under `loads` [1/s^2].
@@ -36,6 +38,9 @@ pub trait Stepper: Send {
     /// Evaluates the forces at `state.y` only (after a restore, which
     /// brings its own accelerations).
     fn evaluate(&mut self, loads: &Loads, state: &State);
+    /// The spring force at `y` in the space's coordinates (see
+    /// [`Space::spring_force`]); the forces at `state.y` are evaluated again after.
+    fn spring_force(&mut self, loads: &Loads, state: &State, y: &[f64], out: &mut [f64]);
     /// One internal step of length `dt`.
     fn step(&mut self, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure>;
     /// Kinetic energy of `state` [J].
@@ -109,6 +114,10 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
         self.space.frequencies()
     }
 
+    fn springs(&self) -> usize {
+        self.space.springs()
+    }
+
     fn stable_step(&self, loads: &Loads) -> Option<f64> {
         I::stable_step(self.space.omega_sq_bound(loads))
     }
@@ -132,6 +141,11 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
 
     fn evaluate(&mut self, loads: &Loads, state: &State) {
         self.space.force(loads, &state.y, &mut self.work, &mut self.buffers.h);
+    }
+
+    fn spring_force(&mut self, loads: &Loads, state: &State, y: &[f64], out: &mut [f64]) {
+        self.space.spring_force(y, &mut self.work, out);
+        self.evaluate(loads, state);
     }
 
     fn step(&mut self, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure> {

@@ -39,6 +39,8 @@ pub enum Quantity {
     ModeWeights,
     /// Length of a communication step [s].
     StepSize,
+    /// Relative error the cubature set is grown to reach.
+    CubatureTolerance,
 }
 
 impl Quantity {
@@ -59,6 +61,7 @@ impl Quantity {
             Quantity::DampingBeta => "stiffness-proportional damping",
             Quantity::ModeWeights => "mode weights",
             Quantity::StepSize => "communication step",
+            Quantity::CubatureTolerance => "cubature tolerance",
         }
     }
 }
@@ -76,6 +79,8 @@ pub enum Expected {
     TwoOrThree,
     /// At least this value.
     AtLeast(f64),
+    /// Above 0 and at most this value.
+    PositiveAtMost(f64),
 }
 
 impl fmt::Display for Expected {
@@ -86,6 +91,7 @@ impl fmt::Display for Expected {
             Expected::Finite => f.write_str("finite"),
             Expected::TwoOrThree => f.write_str("2 or 3"),
             Expected::AtLeast(x) => write!(f, "at least {x}"),
+            Expected::PositiveAtMost(x) => write!(f, "above 0 and at most {x}"),
         }
     }
 }
@@ -163,6 +169,11 @@ pub enum PhysicsError {
     TooManyInternalSteps { h: f64, steps: f64, dt: f64, limit: usize },
     /// A communication step failed; the state is that of its start.
     StepFailed { time: f64, cause: StepFailure },
+    /// The cubature set could not be grown to the tolerance: every
+    /// candidate spring left would make the fit worse.
+    CubatureNotReached { tolerance: f64, reached: f64, springs: usize },
+    /// The exact reduced run that makes the cubature's training poses diverged.
+    CubatureTrainingDiverged { time: f64 },
     /// A snapshot whose arrays do not fit this simulator.
     SnapshotLength { len: usize, expected: usize },
     /// A snapshot holding NaN or infinite values.
@@ -217,6 +228,14 @@ impl fmt::Display for PhysicsError {
                 "no static equilibrium found under gravity: Newton reached {load_fraction} of the load with a residual of \
                  {residual:.2e} of the gravity force; linearize at rest"
             ),
+            CubatureNotReached { tolerance, reached, springs } => write!(
+                f,
+                "the cubature reached a relative force error of {reached:.3e} with {springs} springs and no spring left improves it; \
+                 the tolerance {tolerance:e} needs exact forces"
+            ),
+            CubatureTrainingDiverged { time } => {
+                write!(f, "the exact reduced run that makes the cubature's training poses diverged at t = {time} s; use exact forces")
+            }
             UnstableEquilibrium => {
                 f.write_str("every equilibrium found under gravity is unstable (its stiffness has a negative eigenvalue); linearize at rest")
             }

@@ -38,7 +38,15 @@ pub struct SolverParams {
 impl SolverParams {
     /// `n_modes` modes, the given space and scheme, internal steps of at most 10 ms.
     pub fn new(reduction: Reduction, integrator: Integrator, n_modes: usize) -> Self {
-        SolverParams { reduction, integrator, n_modes, basis: BasisOptions::default(), force: ForceOptions::default(), max_internal_step: 0.01, substepping: true }
+        SolverParams {
+            reduction,
+            integrator,
+            n_modes,
+            basis: BasisOptions::default(),
+            force: ForceOptions::default(),
+            max_internal_step: 0.01,
+            substepping: true,
+        }
     }
 }
 
@@ -225,6 +233,23 @@ impl Simulator {
     /// omega_i of the kept or reported modes, ascending [rad/s].
     pub fn mode_frequencies(&self) -> &[f64] {
         self.engine.frequencies()
+    }
+    /// The spring force at generalized coordinates `y` as the space
+    /// evaluates it: Phi^T f(x* + Phi y) in the modal space (every spring,
+    /// or the cubature), f(x_rest + y) in full space. For diagnostics; the
+    /// run is not affected.
+    pub fn spring_force(&mut self, y: &[f64]) -> Result<Vec<f64>, PhysicsError> {
+        let n = self.state.len();
+        if y.len() != n {
+            return Err(PhysicsError::SnapshotLength { len: y.len(), expected: n });
+        }
+        let mut out = vec![0.0; n];
+        self.engine.spring_force(&self.loads, &self.state, y, &mut out);
+        Ok(out)
+    }
+    /// Springs one force evaluation visits: every spring, or the cubature set.
+    pub fn cubature_springs(&self) -> usize {
+        self.engine.springs()
     }
     /// 1/2 v^T M v [J].
     pub fn kinetic_energy(&self) -> f64 {

@@ -206,6 +206,14 @@ impl Space for Full {
         w.elastic = self.springs.add_to(&self.scene, &w.x, &mut w.springs, h);
     }
 
+    fn spring_force(&self, u: &[f64], w: &mut FullWork, out: &mut [f64]) {
+        for k in 0..u.len() {
+            w.x[k] = self.scene.rest[k] + u[k];
+        }
+        out.fill(0.0);
+        w.elastic = self.springs.add_to(&self.scene, &w.x, &mut w.springs, out);
+    }
+
     fn explicit_velocity(&self, dt: f64, v: &[f64], a: &[f64], h: &[f64], w: &mut FullWork, v1: &mut [f64]) -> Result<(), StepFailure> {
         let mass = &self.scene.dof_mass;
         for k in 0..v1.len() {

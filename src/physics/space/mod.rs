@@ -25,7 +25,7 @@ mod full;
 mod modal;
 
 pub use full::Full;
-pub use modal::{Exact, Modal, Modes, ReducedForce};
+pub use modal::{Cubature, Exact, ForceSetup, Modal, Modes, ReducedForce};
 
 use super::engine::Stepper;
 use super::error::{PhysicsError, StepFailure};
@@ -62,6 +62,10 @@ pub trait Space: Send + Sized + 'static {
     fn coordinates(&self) -> usize;
     /// Modes kept (`None` in full space, where every DOF is integrated).
     fn kept_modes(&self) -> Option<usize>;
+    /// Springs one force evaluation visits.
+    fn springs(&self) -> usize {
+        self.scene().springs.len()
+    }
     /// Angular frequencies of the kept or reported modes at the linearization point, ascending [rad/s].
     fn frequencies(&self) -> &[f64];
     /// Fresh load terms (all zero) and scratch.
@@ -72,6 +76,10 @@ pub trait Space: Send + Sized + 'static {
 
     /// Derives the load terms (damping per coordinate, generalized gravity) from `loads`.
     fn apply_loads(&self, loads: &Loads, w: &mut Self::Work);
+    /// The spring force alone in the space's coordinates (Phi^T f(x) in
+    /// the modal space, as its force model evaluates it; f(x) in full space),
+    /// for diagnostics: it overwrites what the last [`Space::force`] left in `w`.
+    fn spring_force(&self, y: &[f64], w: &mut Self::Work, out: &mut [f64]);
     /// h(y) into `h`; leaves the slot positions and the elastic energy at y in `w`.
     fn force(&self, loads: &Loads, y: &[f64], w: &mut Self::Work, h: &mut [f64]);
     /// The velocity update of explicit Newmark: v1 from
@@ -114,7 +122,12 @@ pub trait Space: Send + Sized + 'static {
 /// `loads` are those at set-up: the basis options that depend on the loads use them.
 pub(crate) fn build(scene: Scene, solver: &SolverParams, loads: &Loads) -> Result<Box<dyn Stepper>, PhysicsError> {
     match solver.reduction {
-        Reduction::Modal => Ok(integrator::bind(Modal::<Exact>::new(scene, solver.n_modes, loads, &solver.basis)?, solver.integrator)),
+        Reduction::Modal => match solver.force.evaluation {
+            ForceEvaluation::Exact => Ok(integrator::bind(Modal::<Exact>::new(scene, solver.n_modes, loads, &solver.basis, &solver.force)?, solver.integrator)),
+            ForceEvaluation::Cubature => {
+                Ok(integrator::bind(Modal::<Cubature>::new(scene, solver.n_modes, loads, &solver.basis, &solver.force)?, solver.integrator))
+            }
+        },
         Reduction::Full => Ok(integrator::bind(Full::new(scene, solver.n_modes, loads, &solver.basis)?, solver.integrator)),
     }
 }

@@ -3,7 +3,7 @@
 //! free DOFs, evaluate the exact forces of every spring, project them onto
 //! the kept modes. Its cost grows with the mesh, not with the modes.
 
-use super::{Modes, ReducedForce};
+use super::{ForceSetup, Modes, ReducedForce};
 use crate::physics::error::PhysicsError;
 use crate::physics::forces::{add_reduced_tangent, SpringForces, SpringScratch};
 use crate::physics::scene::Scene;
@@ -27,7 +27,7 @@ pub struct ExactWork {
 impl ReducedForce for Exact {
     type Work = ExactWork;
 
-    fn new(scene: &Scene, _modes: &Modes) -> Result<Self, PhysicsError> {
+    fn new(scene: &Scene, _modes: &Modes, _setup: &ForceSetup) -> Result<Self, PhysicsError> {
         Ok(Exact { springs: SpringForces::new(scene) })
     }
 

@@ -20,11 +20,13 @@ use faer::linalg::lu::partial_pivoting::{factor::lu_in_place, factor::lu_in_plac
 use faer::perm::PermRef;
 use faer::{Conj, Mat, MatMut, Par, Side};
 
+mod cubature;
 mod exact;
 
+pub use cubature::Cubature;
 pub use exact::Exact;
 
-use super::Space;
+use super::{ForceOptions, Space};
 use crate::physics::basis::{self, BasisOptions};
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::forces::{add_reduced_tangent, omega_sq_bound_full};
@@ -43,7 +45,7 @@ const DENSE_BOUND_MODES: usize = 64;
 pub trait ReducedForce: Send + Sized + 'static {
     type Work: Send + 'static;
     /// Set-up on `scene` for the kept `modes`.
-    fn new(scene: &Scene, modes: &Modes) -> Result<Self, PhysicsError>;
+    fn new(scene: &Scene, modes: &Modes, setup: &ForceSetup) -> Result<Self, PhysicsError>;
     fn work(&self, scene: &Scene, modes: &Modes) -> Self::Work;
     /// Phi^T f_springs(x* + Phi q) into `out` (r values).
     fn project(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &mut Self::Work, out: &mut [f64]);
@@ -56,6 +58,24 @@ pub trait ReducedForce: Send + Sized + 'static {
     /// The exact spring forces of every spring on the free DOFs at `q`, the
     /// coordinates of the last [`Self::project`] (for the error indicator).
     fn spring_forces<'w>(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &'w mut Self::Work) -> &'w [f64];
+    /// Springs one evaluation visits.
+    fn springs(&self, scene: &Scene) -> usize {
+        scene.springs.len()
+    }
+    /// A bound on the squared frequencies of the model's own stiffness when
+    /// it differs from Phi^T K_taut Phi (taken as the larger of the two).
+    fn taut_bound(&self, _scene: &Scene, _modes: &Modes) -> Option<f64> {
+        None
+    }
+}
+
+/// What a force model's set-up may use besides the scene and the modes.
+pub struct ForceSetup<'a> {
+    /// The loads at set-up.
+    pub loads: &'a Loads,
+    pub options: &'a ForceOptions,
+    /// Squared-frequency bound of the reduced system with every spring (1/s^2).
+    pub omega_sq_bound: f64,
 }
 
 /// The kept modes, in the two layouts the loops want, and the point x*
@@ -147,14 +167,15 @@ pub struct ModalWork<W> {
 impl<F: ReducedForce> Modal<F> {
     /// Builds the basis of `n_modes` vectors `options` ask for (under the
     /// set-up `loads`) and sets up the force model.
-    pub fn new(scene: Scene, n_modes: usize, loads: &Loads, options: &BasisOptions) -> Result<Self, PhysicsError> {
+    pub fn new(scene: Scene, n_modes: usize, loads: &Loads, options: &BasisOptions, force_options: &ForceOptions) -> Result<Self, PhysicsError> {
         let built = basis::build(&scene, loads, n_modes, options)?;
         let basis = built.modes;
         let omega_sq_bound = if basis.r <= DENSE_BOUND_MODES { taut_reduced_bound(&scene, &basis)? } else { omega_sq_bound_full(&scene) };
         let newton_scale = scene.free_mass().sqrt() * scene.length_scale().max(f64::MIN_POSITIVE);
         let frequencies = basis.frequencies();
         let modes = Modes::new(basis, built.point, built.at_rest);
-        let force = F::new(&scene, &modes)?;
+        let force = F::new(&scene, &modes, &ForceSetup { loads, options: force_options, omega_sq_bound })?;
+        let omega_sq_bound = force.taut_bound(&scene, &modes).map_or(omega_sq_bound, |b| b.max(omega_sq_bound));
         let inv_mass = scene.dof_mass.iter().map(|m| 1.0 / m).collect();
         Ok(Modal { force, frequencies, omega_sq_bound, newton_scale, inv_mass, modes, scene })
     }
@@ -178,6 +199,10 @@ impl<F: ReducedForce> Space for Modal<F> {
 
     fn kept_modes(&self) -> Option<usize> {
         Some(self.modes.basis.r)
+    }
+
+    fn springs(&self) -> usize {
+        self.force.springs(&self.scene)
     }
 
     fn frequencies(&self) -> &[f64] {
@@ -231,6 +256,10 @@ impl<F: ReducedForce> Space for Modal<F> {
             }
             w.gravity_offset -= fk * (self.modes.point[k] - self.scene.rest[k]);
         }
+    }
+
+    fn spring_force(&self, q: &[f64], w: &mut Self::Work, out: &mut [f64]) {
+        self.force.project(&self.scene, &self.modes, q, &mut w.force, out);
     }
 
     fn force(&self, loads: &Loads, q: &[f64], w: &mut Self::Work, h: &mut [f64]) {
