@@ -2,6 +2,10 @@
 //!
 //! - `internal_step/SCENE`: one internal step, modal (r = 2, 8, 32) against
 //!   full space, both integrators (a call of 100 internal steps, divided by 100);
+//! - `cubature/cloth-3d-NxN`: one explicit internal step of 16 modes of the
+//!   load with a static correction, exact forces against cubature, on the
+//!   30 x 30 and the 100 x 100 cloth (a call of 1000 internal steps, divided
+//!   by 1000: the outputs at the end of a call use every spring);
 //! - `do_step/paper-2d-top-row`: a communication step of one internal step,
 //!   through `Simulator::do_step` and through `fmi3DoStep` of the C ABI, beside
 //!   the internal step alone: the differences are the overheads of a call.
@@ -52,6 +56,35 @@ fn internal_step(c: &mut Criterion) {
                     })
                 });
             }
+        }
+        group.finish();
+    }
+}
+
+fn cubature(c: &mut Criterion) {
+    const STEPS: usize = 1000;
+    for n in [30, 100] {
+        let setup = scenes::cloth(n, n);
+        let mut group = c.benchmark_group(format!("cubature/cloth-3d-{n}x{n}"));
+        group.sample_size(20);
+        for evaluation in [ForceEvaluation::Exact, ForceEvaluation::Cubature] {
+            let mut s = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 16);
+            s.basis = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest };
+            s.force = ForceOptions { evaluation, cubature_tolerance: 0.01 };
+            let probe = setup.with_solver(s.clone()).simulator().unwrap();
+            let dt = probe.max_stable_step().min(1e-3);
+            let mut sim = setup.with_solver(SolverParams { max_internal_step: dt, ..s }).simulator().unwrap();
+            let springs = sim.cubature_springs();
+            group.bench_function(BenchmarkId::new(format!("{evaluation:?}"), format!("{springs} springs")), |b| {
+                b.iter_custom(|iters| {
+                    let t = Instant::now();
+                    for _ in 0..iters {
+                        sim.do_step(dt * STEPS as f64 * (1.0 - 1e-9)).unwrap();
+                    }
+                    assert_eq!(sim.internal_steps_last(), STEPS);
+                    t.elapsed() / STEPS as u32
+                })
+            });
         }
         group.finish();
     }
@@ -108,6 +141,6 @@ fn do_step(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(2));
-    targets = do_step, internal_step
+    targets = do_step, internal_step, cubature
 }
 criterion_main!(benches);

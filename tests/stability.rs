@@ -340,6 +340,42 @@ fn extremes() -> Vec<Extreme> {
             compare: false,
         },
         Extreme {
+            label: "cubature forces on modes of the loads with a static correction (forceEvaluation cubature, cubatureTolerance 0.01), 1 s",
+            applies: all,
+            set: |_| vec![(vr::FORCE_EVALUATION, I(2)), (vr::MODE_SELECTION, I(2)), (vr::STATIC_CORRECTION, B(true))],
+            t_end: one_second,
+            steps: &[0.01],
+            gravity: None,
+            compare: true,
+        },
+        Extreme {
+            label: "cubature forces linearized at the equilibrium (forceEvaluation cubature, linearization equilibrium, modeSelection load, staticCorrection true), 1 s",
+            applies: all,
+            set: |_| vec![(vr::FORCE_EVALUATION, I(2)), (vr::LINEARIZATION, I(2)), (vr::MODE_SELECTION, I(2)), (vr::STATIC_CORRECTION, B(true))],
+            t_end: one_second,
+            steps: &[0.01],
+            gravity: None,
+            compare: true,
+        },
+        Extreme {
+            label: "cubature forces under gravity 1e4 m/s² along -y (forceEvaluation cubature), 0.2 s",
+            applies: all,
+            set: |_| vec![(vr::FORCE_EVALUATION, I(2)), (vr::GRAVITY, F(vec![0.0, -1e4, 0.0]))],
+            t_end: |_, _| 0.2,
+            steps: &[0.01],
+            gravity: None,
+            compare: false,
+        },
+        Extreme {
+            label: "cubature at the tightest tolerance (forceEvaluation cubature, cubatureTolerance 1e-6)",
+            applies: all,
+            set: |_| vec![(vr::FORCE_EVALUATION, I(2)), (vr::CUBATURE_TOLERANCE, F(vec![1e-6]))],
+            t_end: one_second,
+            steps: &[0.01],
+            gravity: None,
+            compare: false,
+        },
+        Extreme {
             label: "modes of the loads without a load (modeSelection load, gravity 0)",
             applies: all,
             set: |_| vec![(vr::MODE_SELECTION, I(2)), (vr::GRAVITY, F(vec![0.0, 0.0, 0.0]))],
@@ -371,6 +407,8 @@ const PARAMETERS: &[&str] = &[
     "modeSelection",
     "staticCorrection",
     "linearization",
+    "forceEvaluation",
+    "cubatureTolerance",
 ];
 
 #[derive(Clone, Debug, PartialEq)]

@@ -36,6 +36,8 @@ pub struct Instance {
     pub(super) states: OwnedStates,
     /// forceResidual passed forceResidualLimit once, and the host was told.
     pub(super) residual_warned: bool,
+    /// The FMU's `resources/setup.bin`, if it has one.
+    pub(super) baked: Option<Vec<u8>>,
 }
 
 impl Instance {
@@ -53,13 +55,32 @@ impl Instance {
             stop_time: None,
             states: OwnedStates::default(),
             residual_warned: false,
+            baked: None,
         }
     }
 
     /// Builds the simulator if parameters changed since the last build.
     pub(super) fn ensure_sim(&mut self) -> R {
         if self.sim.is_none() || self.stale {
-            match self.params.build() {
+            let prebuilt = self.baked.as_ref().and_then(|bytes| match super::bake::read(bytes, &self.params) {
+                Ok(data) => Some(data),
+                Err(why) => {
+                    self.log.log(WARNING, &format!("resources/{} not used, set-up computed: {why}", super::bake::FILE));
+                    None
+                }
+            });
+            let built = match (&prebuilt, self.params.build_with(prebuilt.as_ref())) {
+                (Some(_), Ok(sim)) => {
+                    self.log.log(OK, &format!("set-up taken from resources/{}", super::bake::FILE));
+                    Ok(sim)
+                }
+                (Some(_), Err(e)) => {
+                    self.log.log(WARNING, &format!("resources/{} not used, set-up computed: {e}", super::bake::FILE));
+                    self.params.build()
+                }
+                (None, result) => result,
+            };
+            match built {
                 Ok(sim) => {
                     self.log
                         .log(OK, &format!("simulator set up: {} nodes in {}D, {} modes", sim.scene().n_nodes, sim.scene().dim, sim.mode_frequencies().len()));

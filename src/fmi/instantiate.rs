@@ -57,11 +57,13 @@ pub unsafe fn co_simulation(
         if name.trim().is_empty() {
             return fail("instanceName is empty".into());
         }
+        let mut baked = None;
         let start = if resource_path.is_null() {
             Params::start()
         } else {
             let dir = unsafe { CStr::from_ptr(resource_path) }.to_string_lossy().into_owned();
             let dir = dir.strip_prefix("file://").unwrap_or(&dir).to_string();
+            baked = std::fs::read(std::path::Path::new(&dir).join(super::bake::FILE)).ok();
             let file = std::path::Path::new(&dir).join("startValues.txt");
             match std::fs::read_to_string(&file) {
                 Ok(text) => match Params::from_text(&text) {
@@ -72,7 +74,8 @@ pub unsafe fn co_simulation(
                 Err(_) => Params::start(),
             }
         };
-        let inst = Instance::new(env, logger, logging_on, start);
+        let mut inst = Instance::new(env, logger, logging_on, start);
+        inst.baked = baked;
         inst.log.log(OK, &format!("instance \"{name}\" created"));
         registry::register(inst)
     });

@@ -95,13 +95,18 @@ pub fn describe(e: &PhysicsError, p: &Params) -> String {
         ),
         StepFailed { time, cause } => format!("step from t = {time} s failed: {}", failure(cause)),
         CubatureNotReached { tolerance, reached, springs } => format!(
-            "forceEvaluation = cubature: the cubature set reached a relative force error of {reached:.3e} with {springs} springs \
-             and no spring left improves it, cubatureTolerance = {tolerance:e}; raise cubatureTolerance or use forceEvaluation = exact"
+            "forceEvaluation = cubature: the cubature set reached a relative force error of {reached:.3e} with {springs} springs, \
+             its limit (at most 1000 and half the springs) or where the fit stopped improving, short of half of \
+             cubatureTolerance = {tolerance:e}; raise cubatureTolerance or use forceEvaluation = exact"
         ),
+        CubatureTooManyModes { modes, limit } => {
+            format!("forceEvaluation = cubature is trained for at most {limit} modes, nModes = {modes}; keep fewer modes or use forceEvaluation = exact")
+        }
         CubatureTrainingDiverged { time } => format!(
             "forceEvaluation = cubature: the exact reduced run under gravity that makes the training poses diverged at t = {time} s; \
              use forceEvaluation = exact"
         ),
+        SetupDataMismatch { .. } => e.to_string(),
         SnapshotLength { len, expected } => format!("the state holds {len} values per array, this scene needs {expected}"),
         SnapshotNotFinite => "the state holds non-finite values".into(),
     }

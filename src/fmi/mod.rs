@@ -10,9 +10,11 @@
 //! - [`fmu_state`] and [`serialize`]: FMU states and their byte format;
 //! - [`logging`]: the host's log callback and categories;
 //! - [`model`]: variable values -> physics, physics -> outputs;
+//! - [`bake`]: the baked set-up in `resources/setup.bin`;
 //! - [`messages`]: physics errors as messages naming variables;
 //! - [`variables`]: the variable table generated from `modelDescription/variables.toml`.
 
+pub mod bake;
 pub mod exports;
 pub mod fmu_state;
 pub mod functions;

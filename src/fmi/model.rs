@@ -5,7 +5,7 @@
 
 use super::variables::{index_of, vr, Dim, Variability, Variable, SCENES, VARIABLES};
 use crate::options::{FixedNodes, ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction};
-use crate::physics::{BasisOptions, ForceOptions, Grid, Loads, PhysicsError, Simulator, SolverParams};
+use crate::physics::{BasisOptions, ForceOptions, Grid, Loads, PhysicsError, SetupData, Simulator, SolverParams};
 
 /// Current values of the parameters and inputs, indexed like [`VARIABLES`]
 /// (empty for the other variables). Booleans are 0/1, integers exact
@@ -168,7 +168,12 @@ impl Params {
 
     /// Set-up: the grid, then the simulator (assembly, eigen decomposition).
     pub fn build(&self) -> Result<Simulator, PhysicsError> {
-        Simulator::new(self.grid().build()?, &self.solver(), &self.loads())
+        self.build_with(None)
+    }
+
+    /// Set-up with the costly part taken from a baked `prebuilt` when given.
+    pub fn build_with(&self, prebuilt: Option<&SetupData>) -> Result<Simulator, PhysicsError> {
+        Simulator::with_setup(self.grid().build()?, &self.solver(), &self.loads(), prebuilt)
     }
 }
 

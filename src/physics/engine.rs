@@ -6,6 +6,7 @@
 
 use std::marker::PhantomData;
 
+use super::bake::SetupData;
 use super::error::StepFailure;
 use super::integrator::{Buffers, Scheme};
 use super::scene::Scene;
@@ -23,6 +24,8 @@ pub trait Stepper: Send {
     fn frequencies(&self) -> &[f64];
     /// Springs one force evaluation visits.
     fn springs(&self) -> usize;
+    /// The costly products of the set-up, as data (modal space only).
+    fn setup_data(&self) -> Option<SetupData>;
     /// Longest stable internal step under `loads`, if stability limits it.
     fn stable_step(&self, loads: &Loads) -> Option<f64>;
     /// Squared-frequency bound of the integrated system under `loads` [1/s^2].
@@ -116,6 +119,10 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
 
     fn springs(&self) -> usize {
         self.space.springs()
+    }
+
+    fn setup_data(&self) -> Option<SetupData> {
+        self.space.setup_data()
     }
 
     fn stable_step(&self, loads: &Loads) -> Option<f64> {

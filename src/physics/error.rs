@@ -169,11 +169,15 @@ pub enum PhysicsError {
     TooManyInternalSteps { h: f64, steps: f64, dt: f64, limit: usize },
     /// A communication step failed; the state is that of its start.
     StepFailed { time: f64, cause: StepFailure },
-    /// The cubature set could not be grown to the tolerance: every
-    /// candidate spring left would make the fit worse.
+    /// The cubature set could not be grown to the tolerance within its
+    /// size limit, or no spring left improves the fit.
     CubatureNotReached { tolerance: f64, reached: f64, springs: usize },
+    /// More modes than a cubature is trained for.
+    CubatureTooManyModes { modes: usize, limit: usize },
     /// The exact reduced run that makes the cubature's training poses diverged.
     CubatureTrainingDiverged { time: f64 },
+    /// Stored set-up data that does not fit the scene and solver.
+    SetupDataMismatch { what: &'static str },
     /// A snapshot whose arrays do not fit this simulator.
     SnapshotLength { len: usize, expected: usize },
     /// A snapshot holding NaN or infinite values.
@@ -230,12 +234,16 @@ impl fmt::Display for PhysicsError {
             ),
             CubatureNotReached { tolerance, reached, springs } => write!(
                 f,
-                "the cubature reached a relative force error of {reached:.3e} with {springs} springs and no spring left improves it; \
-                 the tolerance {tolerance:e} needs exact forces"
+                "the cubature reached a relative force error of {reached:.3e} with {springs} springs, its limit (at most 1000 and half \
+                 the springs), or the fit stopped improving; the tolerance {tolerance:e} needs exact forces"
             ),
+            CubatureTooManyModes { modes, limit } => {
+                write!(f, "a cubature is trained for at most {limit} modes, {modes} are kept; keep fewer modes or use exact forces")
+            }
             CubatureTrainingDiverged { time } => {
                 write!(f, "the exact reduced run that makes the cubature's training poses diverged at t = {time} s; use exact forces")
             }
+            SetupDataMismatch { what } => write!(f, "the stored set-up data does not fit the scene and solver: {what}"),
             UnstableEquilibrium => {
                 f.write_str("every equilibrium found under gravity is unstable (its stiffness has a negative eigenvalue); linearize at rest")
             }

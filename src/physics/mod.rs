@@ -13,11 +13,13 @@
 //! - [`engine`]: a space and a scheme bound together;
 //! - [`state`]: [`State`] and [`Loads`], what changes while running;
 //! - [`simulator`]: set-up, sub-stepping, divergence checks, outputs;
+//! - [`bake`]: the costly products of a modal set-up as data, to store and reuse;
 //! - [`error`]: typed errors that name the quantity and the limit.
 //!
 //! One modal force evaluation is the pipeline `expand` (q -> x) -> exact
 //! spring forces in physical space -> `project` (Phi^T f).
 
+pub mod bake;
 pub mod basis;
 pub mod engine;
 pub mod equilibrium;
@@ -31,6 +33,7 @@ pub mod simulator;
 pub mod space;
 pub mod state;
 
+pub use bake::{SetupData, SpringSet};
 pub use basis::{BasisOptions, Linearization, ModeSelection};
 pub use error::{PhysicsError, Quantity, StepFailure};
 pub use grid::{FixedNodes, Grid};

@@ -6,6 +6,7 @@
 //! [`Loads`], a backup of the state taken before every communication step,
 //! and the [`Outputs`] of the last good step.
 
+use super::bake::SetupData;
 use super::basis::BasisOptions;
 use super::engine::{Outputs, Stepper};
 use super::error::{positive, Expected, PhysicsError, Quantity, StepFailure};
@@ -97,6 +98,13 @@ impl Simulator {
     /// eigen decomposition, factorizations), binds its scheme and bounds
     /// its step. Refuses what it cannot run, naming the quantity.
     pub fn new(scene: Scene, solver: &SolverParams, loads: &Loads) -> Result<Self, PhysicsError> {
+        Self::with_setup(scene, solver, loads, None)
+    }
+
+    /// [`Self::new`], with the costly part of a modal set-up taken from
+    /// `prebuilt` (see [`SetupData`]) when given: the run is then bit for
+    /// bit that of a simulator that computed it for the same parameters.
+    pub fn with_setup(scene: Scene, solver: &SolverParams, loads: &Loads, prebuilt: Option<&SetupData>) -> Result<Self, PhysicsError> {
         scene.check()?;
         positive(Quantity::MaxInternalStep, solver.max_internal_step)?;
         if solver.reduction == Reduction::Modal && solver.n_modes == 0 {
@@ -104,7 +112,7 @@ impl Simulator {
         }
         loads.validate(solver.n_modes)?;
         let (free_mass, reach) = (scene.free_mass(), scene.reach());
-        let mut engine = space::build(scene, solver, loads)?;
+        let mut engine = space::build(scene, solver, loads, prebuilt)?;
         engine.apply_loads(loads);
         let mut state = State::at_rest(engine.coordinates());
         engine.rest_coordinates(&mut state.y);
@@ -246,6 +254,11 @@ impl Simulator {
         let mut out = vec![0.0; n];
         self.engine.spring_force(&self.loads, &self.state, y, &mut out);
         Ok(out)
+    }
+    /// The costly products of the set-up (modal space only), to store and
+    /// pass to [`Self::with_setup`] later.
+    pub fn setup_data(&self) -> Option<SetupData> {
+        self.engine.setup_data()
     }
     /// Springs one force evaluation visits: every spring, or the cubature set.
     pub fn cubature_springs(&self) -> usize {

@@ -55,11 +55,33 @@ impl Fmu {
     }
 
     pub fn named(name: &str) -> Fmu {
+        Fmu::with_resources(name, None)
+    }
+
+    /// An instance whose resources folder is `resources` (a path; `file://`
+    /// is optional), with logging on when it has one.
+    pub fn with_resources(name: &str, resources: Option<&str>) -> Fmu {
         let log = Box::<Log>::default();
         let name = CString::new(name).unwrap();
         let token = CString::new(INSTANTIATION_TOKEN).unwrap();
-        let inst =
-            unsafe { fmi3InstantiateCoSimulation(name.as_ptr(), token.as_ptr(), null(), false, false, false, false, null(), 0, log.env(), Some(logger), None) };
+        let dir = resources.map(|r| CString::new(r).unwrap());
+        let dir_ptr = dir.as_ref().map_or(null(), |d| d.as_ptr());
+        let inst = unsafe {
+            fmi3InstantiateCoSimulation(
+                name.as_ptr(),
+                token.as_ptr(),
+                dir_ptr,
+                false,
+                resources.is_some(),
+                false,
+                false,
+                null(),
+                0,
+                log.env(),
+                Some(logger),
+                None,
+            )
+        };
         assert!(!inst.is_null(), "{:?}", log.take());
         Fmu { inst, log }
     }

@@ -161,3 +161,18 @@ def test_basis_options_through_fmpy(default_fmu):
         return np.sqrt(((x - xr) ** 2).sum() / ((xr - xr[0]) ** 2).sum())
 
     assert error(chosen) < 0.5 * error(lowest), (error(chosen), error(lowest))
+
+
+def test_cubature_through_fmpy(default_fmu):
+    """forceEvaluation = cubature as a start value: the run follows the same
+    basis with exact forces closely, and cubatureSprings says how few
+    springs it visits (every spring with exact forces)."""
+    outputs = ["positions", "cubatureSprings"]
+    run = lambda **starts: simulate_fmu(default_fmu, stop_time=2.0, output_interval=0.05, output=outputs, start_values=dict(modeSelection=2, staticCorrection=True, **starts))
+    exact = run()
+    cubature = run(forceEvaluation=2, cubatureTolerance=0.002)
+    springs_all, springs_kept = int(exact["cubatureSprings"][0]), int(cubature["cubatureSprings"][0])
+    assert 0 < springs_kept < springs_all / 2, (springs_kept, springs_all)
+    x, xr = cubature["positions"], exact["positions"]
+    e = np.sqrt(((x - xr) ** 2).sum() / ((xr - xr[0]) ** 2).sum())
+    assert e < 0.01, e

@@ -1,9 +1,12 @@
-//! `cargo xtask fmu [--scene NAME] [--nx N] [--ny N] [--modes R] [--out PATH]`
+//! `cargo xtask fmu [--scene NAME] [--nx N] [--ny N] [--modes R] [--bake] [--out PATH]`
 //!
 //! Builds the cdylib in release mode and packs the FMU: modelDescription.xml
 //! (generated from modelDescription/variables.toml with the chosen start
 //! values), binaries/x86_64-linux/ModalMassSpring.so, documentation/index.html
 //! and resources/startValues.txt (the same start values, read by the binary).
+//! With `--bake`, also resources/setup.bin: the modal set-up of those start
+//! values (basis, equilibrium, cubature set), computed once here by the
+//! `bake` example so that instantiation skips it while the parameters match.
 
 use crate::generate;
 
@@ -21,11 +24,12 @@ struct Options {
     nx: Option<u64>,
     ny: Option<u64>,
     modes: Option<u64>,
+    bake: bool,
     out: Option<PathBuf>,
 }
 
 fn parse(args: &[String]) -> Result<Options, String> {
-    let mut o = Options { scene: None, nx: None, ny: None, modes: None, out: None };
+    let mut o = Options { scene: None, nx: None, ny: None, modes: None, bake: false, out: None };
     let mut it = args.iter();
     while let Some(a) = it.next() {
         let mut value = || it.next().cloned().ok_or(format!("{a} needs a value"));
@@ -36,7 +40,8 @@ fn parse(args: &[String]) -> Result<Options, String> {
             "--ny" => o.ny = Some(number(value()?)?),
             "--modes" => o.modes = Some(number(value()?)?),
             "--out" => o.out = Some(PathBuf::from(value()?)),
-            "-h" | "--help" => return Err("usage: cargo xtask fmu [--scene NAME] [--nx N] [--ny N] [--modes R] [--out PATH]".into()),
+            "--bake" => o.bake = true,
+            "-h" | "--help" => return Err("usage: cargo xtask fmu [--scene NAME] [--nx N] [--ny N] [--modes R] [--bake] [--out PATH]".into()),
             other => return Err(format!("unknown option {other}")),
         }
     }
@@ -114,12 +119,16 @@ pub fn main(args: &[String]) -> Result<(), String> {
     let file = std::fs::File::create(&tmp).map_err(|e| format!("{}: {e}", tmp.display()))?;
     let mut zip = zip::ZipWriter::new(file);
     let opts = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
-    let entries: [(String, &[u8]); 4] = [
+    let baked = if o.bake { bake(&root, &target, &starts)? } else { None };
+    let mut entries: Vec<(String, &[u8])> = vec![
         ("modelDescription.xml".into(), xml.as_bytes()),
         (format!("binaries/{PLATFORM}/{}.so", spec.model_identifier), &binary),
         ("documentation/index.html".into(), html.as_bytes()),
         ("resources/startValues.txt".into(), starts.as_bytes()),
     ];
+    if let Some(b) = &baked {
+        entries.push(("resources/setup.bin".into(), b));
+    }
     for (name, data) in entries {
         zip.start_file(name.as_str(), opts).map_err(|e| e.to_string())?;
         zip.write_all(data).map_err(|e| e.to_string())?;
@@ -128,4 +137,27 @@ pub fn main(args: &[String]) -> Result<(), String> {
     std::fs::rename(&tmp, &out).map_err(|e| format!("{}: {e}", out.display()))?;
     println!("{}", out.display());
     Ok(())
+}
+
+/// Runs the `bake` example on the start values; the bytes of setup.bin, or
+/// `None` where there is nothing to bake (full space).
+fn bake(root: &Path, target: &Path, starts: &str) -> Result<Option<Vec<u8>>, String> {
+    let status = Command::new(crate::setup::cargo())
+        .current_dir(root)
+        .args(["build", "--release", "--example", "bake"])
+        .status()
+        .map_err(|e| format!("cannot run cargo: {e}"))?;
+    if !status.success() {
+        return Err("cargo build --example bake failed".into());
+    }
+    let dir = target.join("bake");
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let (start_file, out) = (dir.join("startValues.txt"), dir.join("setup.bin"));
+    let _ = std::fs::remove_file(&out);
+    std::fs::write(&start_file, starts).map_err(|e| format!("{}: {e}", start_file.display()))?;
+    let status = Command::new(target.join("release/examples/bake")).arg(&start_file).arg(&out).status().map_err(|e| format!("cannot run the bake: {e}"))?;
+    if !status.success() {
+        return Err("the bake failed".into());
+    }
+    Ok(std::fs::read(&out).ok())
 }

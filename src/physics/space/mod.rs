@@ -27,6 +27,7 @@ mod modal;
 pub use full::Full;
 pub use modal::{Cubature, Exact, ForceSetup, Modal, Modes, ReducedForce};
 
+use super::bake::SetupData;
 use super::engine::Stepper;
 use super::error::{PhysicsError, StepFailure};
 use super::integrator;
@@ -65,6 +66,10 @@ pub trait Space: Send + Sized + 'static {
     /// Springs one force evaluation visits.
     fn springs(&self) -> usize {
         self.scene().springs.len()
+    }
+    /// The costly products of the set-up, as data (modal space only).
+    fn setup_data(&self) -> Option<SetupData> {
+        None
     }
     /// Angular frequencies of the kept or reported modes at the linearization point, ascending [rad/s].
     fn frequencies(&self) -> &[f64];
@@ -120,12 +125,15 @@ pub trait Space: Send + Sized + 'static {
 /// The registry of spaces: builds the space `solver.reduction` names on
 /// `scene` and binds it to the integrator `solver.integrator` names.
 /// `loads` are those at set-up: the basis options that depend on the loads use them.
-pub(crate) fn build(scene: Scene, solver: &SolverParams, loads: &Loads) -> Result<Box<dyn Stepper>, PhysicsError> {
+/// `prebuilt` (modal space only) replaces the costly part of the set-up.
+pub(crate) fn build(scene: Scene, solver: &SolverParams, loads: &Loads, prebuilt: Option<&SetupData>) -> Result<Box<dyn Stepper>, PhysicsError> {
     match solver.reduction {
         Reduction::Modal => match solver.force.evaluation {
-            ForceEvaluation::Exact => Ok(integrator::bind(Modal::<Exact>::new(scene, solver.n_modes, loads, &solver.basis, &solver.force)?, solver.integrator)),
+            ForceEvaluation::Exact => {
+                Ok(integrator::bind(Modal::<Exact>::new(scene, solver.n_modes, loads, &solver.basis, &solver.force, prebuilt)?, solver.integrator))
+            }
             ForceEvaluation::Cubature => {
-                Ok(integrator::bind(Modal::<Cubature>::new(scene, solver.n_modes, loads, &solver.basis, &solver.force)?, solver.integrator))
+                Ok(integrator::bind(Modal::<Cubature>::new(scene, solver.n_modes, loads, &solver.basis, &solver.force, prebuilt)?, solver.integrator))
             }
         },
         Reduction::Full => Ok(integrator::bind(Full::new(scene, solver.n_modes, loads, &solver.basis)?, solver.integrator)),

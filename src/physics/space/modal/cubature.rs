@@ -40,6 +40,7 @@ use rand_chacha::rand_core::{RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::{ForceSetup, Modes, ReducedForce};
+use crate::physics::bake::SpringSet;
 use crate::physics::error::PhysicsError;
 use crate::physics::forces::{SpringForces, SpringScratch};
 use crate::physics::scene::Scene;
@@ -53,6 +54,14 @@ const POOL: usize = 512;
 /// Longest training run [s] and most steps it may take.
 const RUN_SECONDS: f64 = 2.0;
 const RUN_STEPS: usize = 4000;
+/// Most modes a cubature is trained for: its training matrix has 96 r rows
+/// and each fit costs rows x springs^2.
+pub const MAX_MODES: usize = 64;
+/// Most springs a cubature set may keep (and at most half the scene's):
+/// beyond, exact forces are as cheap.
+pub const MAX_SPRINGS: usize = 1000;
+/// Rounds without a 1 % fall of the training error before set-up gives up.
+const STALL_ROUNDS: usize = 20;
 /// Seed of the pose and candidate draws.
 const SEED: u64 = 0x6d6f_6461_6c5f_6375;
 
@@ -64,7 +73,8 @@ pub struct Cubature {
     g: Vec<f64>,
     /// Per kept spring, d0 = x*_b - x*_a (D values).
     d0: Vec<f64>,
-    /// Per kept spring: weight times stiffness, rest length.
+    /// Per kept spring: weight, weight times stiffness, rest length.
+    weights: Vec<f64>,
     wk: Vec<f64>,
     l0: Vec<f64>,
     /// c = F0 - sum w p_e(0).
@@ -94,11 +104,23 @@ pub struct CubatureWork {
 impl ReducedForce for Cubature {
     type Work = CubatureWork;
 
+    /// Trains the set, or takes the stored one, and assembles the model.
     fn new(scene: &Scene, modes: &Modes, setup: &ForceSetup) -> Result<Self, PhysicsError> {
-        match scene.dim {
-            2 => train::<2>(scene, modes, setup),
-            _ => train::<3>(scene, modes, setup),
-        }
+        let set = match setup.prebuilt {
+            Some(set) => set.clone(),
+            None => match scene.dim {
+                2 => train::<2>(scene, modes, setup)?,
+                _ => train::<3>(scene, modes, setup)?,
+            },
+        };
+        Ok(match scene.dim {
+            2 => assemble::<2>(scene, modes, set),
+            _ => assemble::<3>(scene, modes, set),
+        })
+    }
+
+    fn spring_set(&self) -> Option<SpringSet> {
+        Some(SpringSet { springs: self.ids.clone(), weights: self.weights.clone(), training_error: self.training_error, held_out_error: self.held_out_error })
     }
 
     fn work(&self, scene: &Scene, modes: &Modes) -> CubatureWork {
@@ -235,7 +257,6 @@ fn uniform(rng: &mut ChaCha8Rng) -> f64 {
     (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
-
 /// One spring's geometry for the training columns.
 struct Candidate<const D: usize> {
     /// Its index in the scene.
@@ -289,7 +310,7 @@ fn norm(v: &[f64]) -> f64 {
 }
 
 /// Chooses the springs and their weights; see the module documentation.
-fn train<const D: usize>(scene: &Scene, modes: &Modes, setup: &ForceSetup) -> Result<Cubature, PhysicsError> {
+fn train<const D: usize>(scene: &Scene, modes: &Modes, setup: &ForceSetup) -> Result<SpringSet, PhysicsError> {
     let tol = setup.options.cubature_tolerance;
     if !(tol > 0.0 && tol <= 1.0) {
         return Err(PhysicsError::Invalid {
@@ -299,6 +320,10 @@ fn train<const D: usize>(scene: &Scene, modes: &Modes, setup: &ForceSetup) -> Re
         });
     }
     let r = modes.basis.r;
+    if r > MAX_MODES {
+        return Err(PhysicsError::CubatureTooManyModes { modes: r, limit: MAX_MODES });
+    }
+    let max_springs = MAX_SPRINGS.min(scene.springs.len() / 2);
     let exact = SpringForces::new(scene);
     let mut scratch = exact.scratch(scene);
     let mut x = modes.point.clone();
@@ -310,8 +335,7 @@ fn train<const D: usize>(scene: &Scene, modes: &Modes, setup: &ForceSetup) -> Re
         exact.add_to(scene, &x, &mut scratch, &mut f);
         modes.project(&f, out);
     };
-    let mut f0 = vec![0.0; r];
-    reduced(&vec![0.0; r], &mut f0);
+    let f0 = exact_at_point(scene, modes, &exact);
 
     let (train_poses, held_poses) = poses(scene, modes, setup, &mut reduced)?;
     // F(q_t) - F0 per pose
@@ -340,7 +364,12 @@ fn train<const D: usize>(scene: &Scene, modes: &Modes, setup: &ForceSetup) -> Re
     let mut held_residual = held_t.clone();
     let (mut train_err, mut held_err) = (norm(&residual) / train_scale, norm(&held_residual) / held_scale);
     let mut column = vec![0.0; mt];
+    // Rounds since the training error last fell by 1 %, and the best error then.
+    let (mut stalled, mut best) = (0usize, train_err);
     while train_err > goal || held_err > goal {
+        if chosen.len() >= max_springs || stalled >= STALL_ROUNDS {
+            return Err(PhysicsError::CubatureNotReached { tolerance: tol, reached: train_err.max(held_err), springs: chosen.len() });
+        }
         // Score a random pool of the springs not chosen yet.
         let pool = POOL.min(candidates.len());
         for i in 0..pool {
@@ -364,10 +393,11 @@ fn train<const D: usize>(scene: &Scene, modes: &Modes, setup: &ForceSetup) -> Re
             if pool == candidates.len() {
                 return Err(PhysicsError::CubatureNotReached { tolerance: tol, reached: train_err.max(held_err), springs: chosen.len() });
             }
+            stalled += 1;
             continue;
         }
         scored.sort_by(|a, b| b.0.total_cmp(&a.0));
-        let add = (chosen.len() / 8).max(1).min(scored.len());
+        let add = (chosen.len() / 4).max(1).min(scored.len()).min(max_springs - chosen.len());
         let mut taken: Vec<usize> = scored[..add].iter().map(|s| s.1).collect();
         taken.sort_unstable_by(|a, b| b.cmp(a));
         for i in taken {
@@ -380,6 +410,17 @@ fn train<const D: usize>(scene: &Scene, modes: &Modes, setup: &ForceSetup) -> Re
             chosen.push((c, tc, hc));
         }
         weights = fit(&chosen, &train_t)?;
+        // Springs the fit gives no weight go back to the pool.
+        let mut k = 0;
+        chosen.retain(|c| {
+            k += 1;
+            let keep = weights[k - 1] > 0.0;
+            if !keep {
+                candidates.push(c.0.index);
+            }
+            keep
+        });
+        weights.retain(|w| *w > 0.0);
         let apply = |target: &[f64], col: fn(&(Candidate<D>, Vec<f64>, Vec<f64>)) -> &Vec<f64>, out: &mut Vec<f64>| {
             out.copy_from_slice(target);
             for (c, w) in chosen.iter().zip(&weights) {
@@ -392,29 +433,61 @@ fn train<const D: usize>(scene: &Scene, modes: &Modes, setup: &ForceSetup) -> Re
         apply(&held_t, |c| &c.2, &mut held_residual);
         train_err = norm(&residual) / train_scale;
         held_err = norm(&held_residual) / held_scale;
+        if train_err < 0.99 * best {
+            (stalled, best) = (0, train_err);
+        } else {
+            stalled += 1;
+        }
     }
 
-    // Keep the springs with a weight; fold their share at q = 0 into c.
+    // The springs with a weight, in scene order (visited along memory).
+    let mut kept: Vec<(usize, f64)> = chosen.iter().zip(&weights).filter(|(_, w)| **w > 0.0).map(|(c, w)| (c.0.index, *w)).collect();
+    kept.sort_by_key(|k| k.0);
+    Ok(SpringSet {
+        springs: kept.iter().map(|k| k.0).collect(),
+        weights: kept.iter().map(|k| k.1).collect(),
+        training_error: train_err,
+        held_out_error: held_err,
+    })
+}
+
+/// F(0) = Phi^T f(x*), exactly, in the same passes a training pose takes.
+fn exact_at_point(scene: &Scene, modes: &Modes, exact: &SpringForces) -> Vec<f64> {
+    let mut x = modes.point.clone();
+    let mut f = vec![0.0; modes.basis.n];
+    let r = modes.basis.r;
+    modes.expand(&vec![0.0; r], &mut x);
+    exact.add_to(scene, &x, &mut exact.scratch(scene), &mut f);
+    let mut out = vec![0.0; r];
+    modes.project(&f, &mut out);
+    out
+}
+
+/// The model of a spring set: each kept spring's G and d0, and
+/// c = F0 - sum w p_e(0).
+fn assemble<const D: usize>(scene: &Scene, modes: &Modes, set: SpringSet) -> Cubature {
+    let r = modes.basis.r;
+    let exact = SpringForces::new(scene);
+    let offset = exact_at_point(scene, modes, &exact);
     let mut cub = Cubature {
         ids: Vec::new(),
         g: Vec::new(),
         d0: Vec::new(),
+        weights: Vec::new(),
         wk: Vec::new(),
         l0: Vec::new(),
-        offset: f0,
+        offset,
         exact,
-        training_error: train_err,
-        held_out_error: held_err,
+        training_error: set.training_error,
+        held_out_error: set.held_out_error,
     };
-    let mut order: Vec<usize> = (0..chosen.len()).filter(|&i| weights[i] > 0.0).collect();
-    // In scene order, so that the kept springs are visited along memory.
-    let ids: Vec<usize> = chosen.iter().map(|(c, _, _)| c.index).collect();
-    order.sort_by_key(|&i| ids[i]);
-    for i in order {
-        let (c, w) = (&chosen[i].0, weights[i]);
-        cub.ids.push(ids[i]);
+    for (&e, &w) in set.springs.iter().zip(&set.weights) {
+        // A spring with both ends held contributes nothing and was never chosen.
+        let Some(c) = Candidate::<D>::new(scene, modes, e) else { continue };
+        cub.ids.push(e);
         cub.g.extend_from_slice(&c.g);
         cub.d0.extend_from_slice(&c.d0);
+        cub.weights.push(w);
         cub.wk.push(w * c.k);
         cub.l0.push(c.l0);
         for j in 0..r {
@@ -422,7 +495,7 @@ fn train<const D: usize>(scene: &Scene, modes: &Modes, setup: &ForceSetup) -> Re
             cub.offset[j] -= w * (0..D).map(|m| c.g[m * r + j] * c.f0[m]).sum::<f64>();
         }
     }
-    Ok(cub)
+    cub
 }
 
 /// The weights of the chosen springs: the non-negative least-squares fit
@@ -521,9 +594,9 @@ fn poses(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::options::ForceEvaluation;
     use crate::physics::basis::{self, BasisOptions, Linearization, ModeSelection};
     use crate::physics::space::ForceOptions;
-    use crate::options::ForceEvaluation;
     use crate::scenes;
 
     /// Central differences of F~ against the tangent -dF~/dq it reports.
@@ -537,7 +610,7 @@ mod tests {
             let modes = Modes::new(built.modes, built.point, built.at_rest);
             let bound = super::super::taut_reduced_bound(&scene, &modes.basis).unwrap();
             let force = ForceOptions { evaluation: ForceEvaluation::Cubature, cubature_tolerance: 0.002 };
-            let cub = Cubature::new(&scene, &modes, &ForceSetup { loads: &setup.loads, options: &force, omega_sq_bound: bound }).unwrap();
+            let cub = Cubature::new(&scene, &modes, &ForceSetup { loads: &setup.loads, options: &force, omega_sq_bound: bound, prebuilt: None }).unwrap();
             let mut w = cub.work(&scene, &modes);
             let r = modes.basis.r;
             let q: Vec<f64> = (0..r).map(|j| 0.3 * (j as f64 + 1.0).sin()).collect();

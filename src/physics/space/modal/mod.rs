@@ -27,6 +27,7 @@ pub use cubature::Cubature;
 pub use exact::Exact;
 
 use super::{ForceOptions, Space};
+use crate::physics::bake::{SetupData, SpringSet};
 use crate::physics::basis::{self, BasisOptions};
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::forces::{add_reduced_tangent, omega_sq_bound_full};
@@ -62,6 +63,10 @@ pub trait ReducedForce: Send + Sized + 'static {
     fn springs(&self, scene: &Scene) -> usize {
         scene.springs.len()
     }
+    /// The springs and weights the model uses, if it chose them at set-up.
+    fn spring_set(&self) -> Option<SpringSet> {
+        None
+    }
     /// A bound on the squared frequencies of the model's own stiffness when
     /// it differs from Phi^T K_taut Phi (taken as the larger of the two).
     fn taut_bound(&self, _scene: &Scene, _modes: &Modes) -> Option<f64> {
@@ -76,6 +81,8 @@ pub struct ForceSetup<'a> {
     pub options: &'a ForceOptions,
     /// Squared-frequency bound of the reduced system with every spring (1/s^2).
     pub omega_sq_bound: f64,
+    /// A stored set of springs and weights to use instead of computing one.
+    pub prebuilt: Option<&'a SpringSet>,
 }
 
 /// The kept modes, in the two layouts the loops want, and the point x*
@@ -135,6 +142,8 @@ pub struct Modal<F: ReducedForce = Exact> {
     frequencies: Vec<f64>,
     /// Squared-frequency bound of the reduced system with unit weights.
     omega_sq_bound: f64,
+    /// The same with every spring (before the force model's own bound).
+    bound: f64,
     /// The modal coordinate of a one-length-scale displacement of the whole mass.
     newton_scale: f64,
     /// 1 / m_k per free DOF.
@@ -167,17 +176,35 @@ pub struct ModalWork<W> {
 impl<F: ReducedForce> Modal<F> {
     /// Builds the basis of `n_modes` vectors `options` ask for (under the
     /// set-up `loads`) and sets up the force model.
-    pub fn new(scene: Scene, n_modes: usize, loads: &Loads, options: &BasisOptions, force_options: &ForceOptions) -> Result<Self, PhysicsError> {
-        let built = basis::build(&scene, loads, n_modes, options)?;
-        let basis = built.modes;
-        let omega_sq_bound = if basis.r <= DENSE_BOUND_MODES { taut_reduced_bound(&scene, &basis)? } else { omega_sq_bound_full(&scene) };
+    /// The basis, its point and the bound come from `prebuilt` when given
+    /// (checked to fit), else they are computed.
+    pub fn new(
+        scene: Scene,
+        n_modes: usize,
+        loads: &Loads,
+        options: &BasisOptions,
+        force_options: &ForceOptions,
+        prebuilt: Option<&SetupData>,
+    ) -> Result<Self, PhysicsError> {
+        let (modes, bound) = match prebuilt {
+            Some(data) => {
+                check_prebuilt(&scene, n_modes, data)?;
+                (Modes::new(data.basis.clone(), data.point.clone(), data.at_rest), data.omega_sq_bound)
+            }
+            None => {
+                let built = basis::build(&scene, loads, n_modes, options)?;
+                let basis = built.modes;
+                let bound = if basis.r <= DENSE_BOUND_MODES { taut_reduced_bound(&scene, &basis)? } else { omega_sq_bound_full(&scene) };
+                (Modes::new(basis, built.point, built.at_rest), bound)
+            }
+        };
         let newton_scale = scene.free_mass().sqrt() * scene.length_scale().max(f64::MIN_POSITIVE);
-        let frequencies = basis.frequencies();
-        let modes = Modes::new(basis, built.point, built.at_rest);
-        let force = F::new(&scene, &modes, &ForceSetup { loads, options: force_options, omega_sq_bound })?;
-        let omega_sq_bound = force.taut_bound(&scene, &modes).map_or(omega_sq_bound, |b| b.max(omega_sq_bound));
+        let frequencies = modes.basis.frequencies();
+        let setup = ForceSetup { loads, options: force_options, omega_sq_bound: bound, prebuilt: prebuilt.and_then(|d| d.cubature.as_ref()) };
+        let force = F::new(&scene, &modes, &setup)?;
+        let omega_sq_bound = force.taut_bound(&scene, &modes).map_or(bound, |b| b.max(bound));
         let inv_mass = scene.dof_mass.iter().map(|m| 1.0 / m).collect();
-        Ok(Modal { force, frequencies, omega_sq_bound, newton_scale, inv_mass, modes, scene })
+        Ok(Modal { force, frequencies, omega_sq_bound, bound, newton_scale, inv_mass, modes, scene })
     }
 
     /// The kept modes.
@@ -203,6 +230,16 @@ impl<F: ReducedForce> Space for Modal<F> {
 
     fn springs(&self) -> usize {
         self.force.springs(&self.scene)
+    }
+
+    fn setup_data(&self) -> Option<SetupData> {
+        Some(SetupData {
+            basis: self.modes.basis.clone(),
+            point: self.modes.point.clone(),
+            at_rest: self.modes.at_rest,
+            omega_sq_bound: self.bound,
+            cubature: self.force.spring_set(),
+        })
     }
 
     fn frequencies(&self) -> &[f64] {
@@ -385,6 +422,28 @@ impl<F: ReducedForce> Space for Modal<F> {
     fn modal_coordinates(&self, q: &[f64], out: &mut [f64]) {
         out.copy_from_slice(q);
     }
+}
+
+/// Stored set-up data fits `scene` and `n_modes`: sizes, finite values, unit-mass modes are not re-checked
+/// (the data is what a set-up of the same parameters wrote).
+fn check_prebuilt(scene: &Scene, n_modes: usize, data: &SetupData) -> Result<(), PhysicsError> {
+    let b = &data.basis;
+    let fail = |what| Err(PhysicsError::SetupDataMismatch { what });
+    if b.n != scene.n_dofs() || b.r != n_modes || b.phi.len() != b.n * b.r || b.lambda.len() != b.r {
+        return fail("basis size");
+    }
+    if data.point.len() != scene.rest.len() {
+        return fail("linearization point size");
+    }
+    if !b.phi.iter().chain(&b.lambda).chain(&data.point).all(|x| x.is_finite()) || !(data.omega_sq_bound >= 0.0 && data.omega_sq_bound.is_finite()) {
+        return fail("non-finite values");
+    }
+    if let Some(c) = &data.cubature {
+        if c.springs.len() != c.weights.len() || c.springs.iter().any(|&s| s >= scene.springs.len()) || !c.weights.iter().all(|w| w.is_finite() && *w > 0.0) {
+            return fail("cubature set");
+        }
+    }
+    Ok(())
 }
 
 /// lambda_max(Phi^T K_taut Phi): bound on the squared frequencies of the

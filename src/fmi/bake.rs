@@ -1,0 +1,109 @@
+//! Baked set-up: `resources/setup.bin`, written by `cargo xtask fmu --bake`,
+//! holds the costly products of the modal set-up ([`SetupData`]: basis,
+//! linearization point, cubature set) with the parameter values they were
+//! computed for. An instance whose values match uses them and skips the
+//! eigen decomposition, the equilibrium and the cubature training, with a
+//! bit-identical run; one whose values differ (or a file that is corrupt or
+//! from another build) computes the set-up and logs why.
+//!
+//! The key is every structural and fixed parameter and the set-up gravity,
+//! except those set-up does not read ([`NOT_READ_BY_SETUP`]). File layout
+//! (little-endian): magic `MMSBAKE1`, the crate version (u32 length +
+//! bytes), the key (u32 count, then per variable u32 value reference, u32
+//! count, f64 bits), the data (u64 length + [`SetupData::to_bytes`]), and a
+//! CRC-32 of everything before it.
+
+use super::model::Params;
+use super::variables::{vr, Variability, VARIABLES};
+use crate::physics::{SetupData, Simulator};
+
+/// File name under `resources/`.
+pub const FILE: &str = "setup.bin";
+const MAGIC: &[u8; 8] = b"MMSBAKE1";
+/// Fixed parameters the set-up of the basis and the cubature does not read.
+const NOT_READ_BY_SETUP: &[u32] = &[vr::INTEGRATOR, vr::MAX_INTERNAL_STEP];
+
+/// The values the set-up depends on, by value reference.
+fn key(p: &Params) -> Vec<(u32, Vec<f64>)> {
+    VARIABLES
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.holds_value() && (v.variability == Variability::Fixed || v.vr == vr::GRAVITY) && !NOT_READ_BY_SETUP.contains(&v.vr))
+        .map(|(i, v)| (v.vr, p.values[i].clone()))
+        .collect()
+}
+
+/// The bake of `sim`, set up from `p`; `None` in full space (nothing costly to keep).
+pub fn write(p: &Params, sim: &Simulator) -> Option<Vec<u8>> {
+    let data = sim.setup_data()?.to_bytes();
+    let mut b = Vec::new();
+    b.extend_from_slice(MAGIC);
+    let version = env!("CARGO_PKG_VERSION").as_bytes();
+    b.extend_from_slice(&(version.len() as u32).to_le_bytes());
+    b.extend_from_slice(version);
+    let key = key(p);
+    b.extend_from_slice(&(key.len() as u32).to_le_bytes());
+    for (r, values) in &key {
+        b.extend_from_slice(&r.to_le_bytes());
+        b.extend_from_slice(&(values.len() as u32).to_le_bytes());
+        values.iter().for_each(|x| b.extend_from_slice(&x.to_bits().to_le_bytes()));
+    }
+    b.extend_from_slice(&(data.len() as u64).to_le_bytes());
+    b.extend_from_slice(&data);
+    let crc = crc32fast::hash(&b);
+    b.extend_from_slice(&crc.to_le_bytes());
+    Some(b)
+}
+
+/// The set-up data of a bake if it was made for the values of `p`, else why not.
+pub fn read(bytes: &[u8], p: &Params) -> Result<SetupData, String> {
+    let corrupt = || "the file is corrupt".to_string();
+    if bytes.len() < MAGIC.len() + 4 || &bytes[..MAGIC.len()] != MAGIC {
+        return Err("it is not a baked set-up".into());
+    }
+    let (body, crc) = bytes.split_at(bytes.len() - 4);
+    if crc32fast::hash(body).to_le_bytes() != crc {
+        return Err(corrupt());
+    }
+    let mut at = MAGIC.len();
+    let mut take = |n: usize| -> Result<&[u8], String> {
+        let s = body.get(at..at.checked_add(n).ok_or_else(corrupt)?).ok_or_else(corrupt)?;
+        at += n;
+        Ok(s)
+    };
+    let u32_of = |s: &[u8]| u32::from_le_bytes(s.try_into().unwrap()) as usize;
+    let n = u32_of(take(4)?);
+    let version = take(n)?;
+    if version != env!("CARGO_PKG_VERSION").as_bytes() {
+        return Err(format!("it was baked by version {} of the FMU, this is {}", String::from_utf8_lossy(version), env!("CARGO_PKG_VERSION")));
+    }
+    let count = u32_of(take(4)?);
+    let mut stored = Vec::with_capacity(count.min(VARIABLES.len()));
+    for _ in 0..count {
+        let r = u32_of(take(4)?) as u32;
+        let n = u32_of(take(4)?);
+        let raw = take(n.checked_mul(8).ok_or_else(corrupt)?)?;
+        stored.push((r, raw.chunks_exact(8).map(|c| f64::from_bits(u64::from_le_bytes(c.try_into().unwrap()))).collect::<Vec<f64>>()));
+    }
+    for (r, values) in key(p) {
+        let name = VARIABLES.iter().find(|v| v.vr == r).map_or("?", |v| v.name);
+        match stored.iter().find(|(s, _)| *s == r) {
+            Some((_, baked)) if *baked == values => {}
+            Some((_, baked)) => return Err(format!("it was baked for {name} = {}, the instance has {}", show(baked), show(&values))),
+            None => return Err(format!("it holds no value of {name}")),
+        }
+    }
+    if stored.len() != key(p).len() {
+        return Err("it was baked for other parameters".into());
+    }
+    let len = u64::from_le_bytes(take(8)?.try_into().unwrap()) as usize;
+    let data = take(len)?;
+    if at != body.len() {
+        return Err(corrupt());
+    }
+    SetupData::from_bytes(data).ok_or_else(corrupt)
+}
+
+fn show(v: &[f64]) -> String {
+    v.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(" ")
+}
