@@ -36,7 +36,13 @@ fn do_step_allocates_nothing() {
     let load = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest };
     let equilibrium = BasisOptions { linearization: Linearization::Equilibrium, ..load.clone() };
     let cubature = ForceOptions { evaluation: ForceEvaluation::Cubature, cubature_tolerance: 0.01 };
-    let options = [paper.clone(), (load.clone(), ForceOptions::default()), (equilibrium.clone(), ForceOptions::default()), (load, cubature.clone()), (equilibrium, cubature)];
+    let options = [
+        paper.clone(),
+        (load.clone(), ForceOptions::default()),
+        (equilibrium.clone(), ForceOptions::default()),
+        (load, cubature.clone()),
+        (equilibrium, cubature),
+    ];
     for name in ["paper-2d-top-row", "paper-3d-sheet"] {
         for reduction in [Reduction::Modal, Reduction::Full] {
             for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit] {
