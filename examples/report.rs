@@ -155,7 +155,7 @@ fn main() {
             max_internal_step,
             substepping: true,
             basis: BasisOptions::default(),
-        force: ForceOptions::default(),
+            force: ForceOptions::default(),
         };
         let mut mode_counts: Vec<usize> = std::iter::successors(Some(1usize), |r| Some(r * 2)).take_while(|&r| r < n).collect();
         // Beyond a quarter of the DOFs the basis needs the dense eigensolver;
@@ -182,7 +182,7 @@ fn main() {
                         max_internal_step: h,
                         substepping: true,
                         basis: BasisOptions::default(),
-                    force: ForceOptions::default(),
+                        force: ForceOptions::default(),
                     };
                     // The implicit Newton matrix Phi^T K(x) Phi costs about
                     // springs x r^2 x 30 flops per iteration; beyond
@@ -228,7 +228,7 @@ fn main() {
             max_internal_step,
             substepping: true,
             basis: BasisOptions::default(),
-        force: ForceOptions::default(),
+            force: ForceOptions::default(),
         };
         bar.set_message(format!("{}: reference", case.label));
         let reference = simulate(p, &full(Integrator::NewmarkExplicit, reference_dt), reference_dt, seconds, f64::INFINITY).expect("reference run failed");
