@@ -29,6 +29,8 @@ INTERFACE = {
     "modeSelection": ("Enumeration", "parameter", "fixed"),
     "staticCorrection": ("Boolean", "parameter", "fixed"),
     "linearization": ("Enumeration", "parameter", "fixed"),
+    "forceEvaluation": ("Enumeration", "parameter", "fixed"),
+    "cubatureTolerance": ("Float64", "parameter", "fixed"),
     "forceResidualLimit": ("Float64", "parameter", "tunable"),
     "gravity": ("Float64", "parameter", "tunable"),
     "dampingAlpha": ("Float64", "parameter", "tunable"),
@@ -40,6 +42,7 @@ INTERFACE = {
     "kineticEnergy": ("Float64", "output", "continuous"),
     "potentialEnergy": ("Float64", "output", "continuous"),
     "forceResidual": ("Float64", "output", "continuous"),
+    "cubatureSprings": ("UInt64", "calculatedParameter", "fixed"),
     "modeFrequencies": ("Float64", "calculatedParameter", "fixed"),
 }
 
