@@ -1,43 +1,139 @@
-"""Plots of the error-against-run-time study: error against run time
-(log-log, one series per method and integrator) and error against the number
-of modes, one figure per scene."""
+"""Plots of the error-against-run-time study, one figure per scene: error
+against run time (log-log; full space in black, modal runs coloured by
+variant, marker by integrator), error against the number of modes (explicit
+runs at the shortest and longest step, coloured by variant) and error against
+the largest forceResidual of each modal run (coloured by variant; Spearman's
+rank correlation in the title). force_residual.png: E against the largest and
+the mean forceResidual of the leave-out runs of every scene."""
 import csv
 import sys
 from collections import defaultdict
 
 import matplotlib
+import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
 rows = list(csv.DictReader(open(sys.argv[1])))
 out = sys.argv[2]
+
+# Colours by variant, in the order of examples/report.rs; others cycle.
+VARIANTS = ["paper", "load", "load+static", "load+static@equilibrium", "load+cubature",
+            "load+static+cubature", "load+static@equilibrium+cubature"]
+PALETTE = plt.get_cmap("tab10").colors
+COLOUR = {v: PALETTE[i % len(PALETTE)] for i, v in enumerate(VARIANTS)}
+MARKER = {"newmark-explicit": "o", "newmark-implicit": "^"}
+
+
+def variant(r):
+    return r.get("variant") or ("full" if r["method"] == "full" else "paper")
+
+
+def colour(v):
+    if v == "full":
+        return "black"
+    if v not in COLOUR:
+        COLOUR[v] = PALETTE[len(COLOUR) % len(PALETTE)]
+    return COLOUR[v]
+
+
+def f(r, column):
+    try:
+        return float(r.get(column) or "nan")
+    except ValueError:
+        return float("nan")
+
+
+def spearman(x, y):
+    """Spearman's rank correlation (ties share their mean rank), numpy only."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    if len(x) < 3:
+        return float("nan")
+
+    def ranks(v):
+        order = np.argsort(v, kind="mergesort")
+        r = np.empty(len(v))
+        r[order] = np.arange(1, len(v) + 1)
+        for value in np.unique(v):
+            tied = v == value
+            r[tied] = r[tied].mean()
+        return r
+
+    rx, ry = ranks(x), ranks(y)
+    rx, ry = rx - rx.mean(), ry - ry.mean()
+    return float((rx * ry).sum() / np.sqrt((rx * rx).sum() * (ry * ry).sum()))
+
+
+def leaves_out(r):
+    return r["method"] == "modal" and int(r["modes"]) < int(r["dofs"])
+
+
 by_scene = defaultdict(list)
 for r in rows:
-    if r["stable"] == "true" and float(r["error"]) > 0:
+    if r["stable"] == "true" and f(r, "error") > 0:
         by_scene[r["scene"]].append(r)
 
 for scene, rs in by_scene.items():
-    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 5))
+    fig, (a, b, c) = plt.subplots(1, 3, figsize=(18, 5.5))
     series = defaultdict(list)
     for r in rs:
-        series[(r["method"], r["integrator"])].append(r)
-    for (method, integ), pts in sorted(series.items()):
-        a.loglog([float(p["run_s_per_sim_s"]) for p in pts], [float(p["error"]) for p in pts], "o" if method == "modal" else "s", label=f"{method} {integ}", alpha=0.7)
-        if method == "modal":
-            for step in sorted({p["step_label"] for p in pts}):
-                sp = sorted((p for p in pts if p["step_label"] == step), key=lambda p: int(p["modes"]))
-                b.loglog([int(p["modes"]) for p in sp], [float(p["error"]) for p in sp], "o-", label=f"{integ} step {step}")
+        series[(variant(r), r["integrator"])].append(r)
+    order = {v: i for i, v in enumerate(["full"] + VARIANTS)}
+    for (v, integ), pts in sorted(series.items(), key=lambda kv: (order.get(kv[0][0], 99), kv[0][1])):
+        marker = "s" if v == "full" else MARKER.get(integ, "o")
+        a.loglog([f(p, "run_s_per_sim_s") for p in pts], [f(p, "error") for p in pts], marker, color=colour(v),
+                 label=f"{v} {integ.replace('newmark-', '')}", alpha=0.75, markersize=5,
+                 markerfacecolor="none" if integ == "newmark-implicit" else colour(v))
+    modal = [r for r in rs if r["method"] == "modal" and r["integrator"] == "newmark-explicit"]
+    steps = sorted({r["step_label"] for r in modal}, key=lambda s: float(s.split("/")[1]) if "/" in s else 0)
+    shown = [steps[-1], steps[0]] if len(steps) > 1 else steps
+    for v in [v for v in VARIANTS if any(variant(r) == v for r in modal)] + sorted({variant(r) for r in modal} - set(VARIANTS)):
+        for k, step in enumerate(shown):
+            sp = sorted((p for p in modal if variant(p) == v and p["step_label"] == step), key=lambda p: int(p["modes"]))
+            if sp:
+                b.loglog([int(p["modes"]) for p in sp], [f(p, "error") for p in sp], "o-" if k == 0 else "s--", color=colour(v),
+                         label=f"{v} step {step}", alpha=0.8, markersize=4)
+    fr = [r for r in rs if leaves_out(r) and np.isfinite(f(r, "force_residual_max"))]
+    for v in sorted({variant(r) for r in fr}, key=lambda v: order.get(v, 99)):
+        pts = [r for r in fr if variant(r) == v and f(r, "force_residual_max") > 0]
+        c.loglog([f(p, "force_residual_max") for p in pts], [f(p, "error_resolved") for p in pts], "o", color=colour(v), label=v, alpha=0.7, markersize=5)
+    rho = spearman([f(r, "force_residual_max") for r in fr], [f(r, "error_resolved") for r in fr])
     a.set_xlabel("run time per simulated second (s)")
     a.set_ylabel("trajectory error E")
     a.set_title(f"{scene}: error against run time")
-    a.legend(fontsize=8)
-    a.grid(True, which="both", alpha=0.3)
+    a.legend(fontsize=6, ncol=2)
     b.set_xlabel("modes kept r")
     b.set_ylabel("trajectory error E")
-    b.set_title(f"{scene}: error against modes")
-    b.legend(fontsize=7)
-    b.grid(True, which="both", alpha=0.3)
+    b.set_title(f"{scene}: error against modes (explicit)")
+    b.legend(fontsize=6, ncol=2)
+    c.set_xlabel("largest forceResidual over the run")
+    c.set_ylabel("trajectory error E (resolved window)")
+    c.set_title(f"{scene}: E against forceResidual (Spearman {rho:.2f})")
+    c.legend(fontsize=6)
+    for ax in (a, b, c):
+        ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
     fig.savefig(f"{out}/{scene}.png", dpi=90)
     plt.close(fig)
+
+# forceResidual against E, every scene.
+fig, axes = plt.subplots(1, 2, figsize=(13, 5.5))
+cmap = plt.get_cmap("tab10").colors
+for ax, column, name in zip(axes, ["force_residual_max", "force_residual_mean"], ["largest", "mean"]):
+    xs, ys = [], []
+    for i, (scene, rs) in enumerate(by_scene.items()):
+        pts = [r for r in rs if leaves_out(r) and np.isfinite(f(r, column))]
+        x, y = [f(p, column) for p in pts], [f(p, "error_resolved") for p in pts]
+        xs += x
+        ys += y
+        ax.loglog([a for a in x if a > 0], [b for a, b in zip(x, y) if a > 0], "o", color=cmap[i % len(cmap)], alpha=0.6, markersize=4,
+                  label=f"{scene} (ρ = {spearman(x, y):.2f}, {len(x)} runs)")
+    ax.set_xlabel(f"{name} forceResidual over the run")
+    ax.set_ylabel("trajectory error E (resolved window)")
+    ax.set_title(f"E against the {name} forceResidual, leave-out runs (Spearman {spearman(xs, ys):.2f})")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+fig.tight_layout()
+fig.savefig(f"{out}/force_residual.png", dpi=90)
+plt.close(fig)

@@ -1,18 +1,38 @@
-//! `cargo xtask report [--quick] [--out DIR]`: runs the error-against-run-time
-//! study (examples/report.rs) in release mode, then draws its plots with the
-//! project's Python environment (`cargo xtask setup` makes it).
+//! `cargo xtask report [--quick] [--out DIR] [--log] [--scene NAME]... [--variants-only]`:
+//! runs the error-against-run-time study (examples/report.rs) in release
+//! mode, then draws its plots with the project's Python environment
+//! (`cargo xtask setup` makes it). `--log` prints every run as it ends;
+//! `--scene` and `--variants-only` make a partial report, for trying it out.
 
 use std::process::Command;
 
 pub fn main(args: &[String]) -> Result<(), String> {
     let quick = args.iter().any(|a| a == "--quick");
     let out = args.iter().position(|a| a == "--out").and_then(|i| args.get(i + 1)).cloned().unwrap_or_else(|| "report".into());
-    run(quick, &out, &[])
+    // What the study itself takes besides --quick and --out.
+    let mut study_args = Vec::new();
+    let mut i = 0;
+    while i < args.len() {
+        match args[i].as_str() {
+            "--log" | "--variants-only" => study_args.push(args[i].clone()),
+            "--scene" => {
+                study_args.extend(args.get(i..i + 2).ok_or("--scene takes a scene name")?.iter().cloned());
+                i += 1;
+            }
+            _ => {}
+        }
+        i += 1;
+    }
+    run_with(quick, &out, &[], &study_args)
 }
 
 /// The study with `cargo_args` added to its `cargo run` (`cargo xtask test`
 /// passes its own features, so the example reuses the test build).
 pub fn run(quick: bool, out: &str, cargo_args: &[&str]) -> Result<(), String> {
+    run_with(quick, out, cargo_args, &[])
+}
+
+fn run_with(quick: bool, out: &str, cargo_args: &[&str], study_args: &[String]) -> Result<(), String> {
     let date = Command::new("date").arg("-u").arg("+%Y-%m-%d").output().ok().and_then(|o| String::from_utf8(o.stdout).ok()).unwrap_or_default();
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
@@ -37,6 +57,7 @@ pub fn run(quick: bool, out: &str, cargo_args: &[&str]) -> Result<(), String> {
     if quick {
         cmd.arg("--quick");
     }
+    cmd.args(study_args);
     cmd.env("REPORT_DATE", format!("{} on {cpu}", date.trim()));
     let status = cmd.status().map_err(|e| format!("cannot run the study: {e}"))?;
     if !status.success() {
