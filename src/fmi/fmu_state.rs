@@ -53,10 +53,13 @@ impl Drop for OwnedStates {
 }
 
 /// Every output of the simulator is a finite number.
-pub fn outputs_finite(sim: &Simulator) -> bool {
-    [sim.positions(), sim.velocities(), sim.modal_coordinates(), &[sim.kinetic_energy(), sim.potential_energy()]]
-        .iter()
-        .all(|a| a.iter().all(|x| x.is_finite()))
+pub fn outputs_finite(sim: &mut Simulator) -> bool {
+    let finite = |a: &[f64]| a.iter().all(|x| x.is_finite());
+    finite(sim.positions())
+        && finite(sim.velocities())
+        && finite(sim.modal_coordinates())
+        && sim.kinetic_energy().is_finite()
+        && sim.potential_energy().is_finite()
 }
 
 impl Instance {

@@ -184,7 +184,7 @@ pub enum Computed<'a> {
 }
 
 /// Outputs and calculated parameters; `time0` is the start time of the run.
-pub fn computed(sim: &Simulator, vr: u32, time0: f64) -> Computed<'_> {
+pub fn computed(sim: &mut Simulator, vr: u32, time0: f64) -> Computed<'_> {
     match vr {
         vr::TIME => Computed::Scalar(time0 + sim.time()),
         vr::POSITIONS => Computed::Array(sim.positions()),

@@ -120,7 +120,7 @@ impl Instance {
             } else if v.causality == Causality::Independent {
                 out[k] = conv(self.time());
             } else {
-                match computed(self.sim.as_ref().unwrap(), r, self.start_time) {
+                match computed(self.sim.as_mut().unwrap(), r, self.start_time) {
                     Computed::Scalar(x) => out[k] = conv(x),
                     Computed::Array(a) => {
                         if a.len() != n {

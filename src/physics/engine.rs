@@ -48,8 +48,18 @@ pub trait Stepper: Send {
     fn step(&mut self, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure>;
     /// Kinetic energy of `state` [J].
     fn kinetic_energy(&self, state: &State) -> f64;
-    /// The outputs of `state` (whose forces were evaluated last).
-    fn outputs(&mut self, loads: &Loads, state: &State, out: &mut Outputs);
+    /// Potential energy of `state` as the force model sums it (see
+    /// [`Space::model_energy`]), for the step guard [J].
+    fn model_energy(&mut self, loads: &Loads, state: &State) -> f64;
+    /// Coordinates of the kept or reported modes.
+    fn modal_coordinates(&self, state: &State, out: &mut [f64]);
+    /// Node positions and velocities of `state` (whose forces were
+    /// evaluated last) into `out`.
+    fn node_outputs(&mut self, state: &State, out: &mut Outputs);
+    /// Elastic energy of every spring plus gravity potential at `state` [J].
+    fn potential_energy(&mut self, loads: &Loads, state: &State) -> f64;
+    /// The force the space cannot represent at `state`, relative to the load.
+    fn force_residual(&mut self, loads: &Loads, state: &State) -> f64;
 }
 
 /// Everything a simulator reports after a step.
@@ -163,19 +173,31 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
         self.space.kinetic_energy(&state.v)
     }
 
-    fn outputs(&mut self, loads: &Loads, state: &State, out: &mut Outputs) {
+    fn model_energy(&mut self, loads: &Loads, state: &State) -> f64 {
+        self.space.model_energy(loads, &state.y, &mut self.work)
+    }
+
+    fn modal_coordinates(&self, state: &State, out: &mut [f64]) {
+        self.space.modal_coordinates(&state.y, out);
+    }
+
+    fn node_outputs(&mut self, state: &State, out: &mut Outputs) {
         let space = &self.space;
         let scene = space.scene();
-        out.kinetic = space.kinetic_energy(&state.v);
         space.dof_velocities(&state.v, &mut out.dof_velocities);
-        space.modal_coordinates(&state.y, &mut out.modal_coordinates);
         let x = space.positions(&state.y, &mut self.work);
         match scene.dim {
             2 => to_node_order::<2>(&scene.slot_of_node, scene.n_free, x, &out.dof_velocities, &mut out.positions, &mut out.velocities),
             _ => to_node_order::<3>(&scene.slot_of_node, scene.n_free, x, &out.dof_velocities, &mut out.positions, &mut out.velocities),
         }
-        out.potential = space.elastic_energy(&state.y, &mut self.work) + space.gravity_potential(loads, &state.y, &self.work);
-        out.force_residual = space.force_residual(loads, &state.y, &mut self.work);
+    }
+
+    fn potential_energy(&mut self, loads: &Loads, state: &State) -> f64 {
+        self.space.elastic_energy(&state.y, &mut self.work) + self.space.gravity_potential(loads, &state.y, &self.work)
+    }
+
+    fn force_residual(&mut self, loads: &Loads, state: &State) -> f64 {
+        self.space.force_residual(loads, &state.y, &mut self.work)
     }
 }
 

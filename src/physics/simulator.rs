@@ -4,7 +4,12 @@
 //!
 //! It holds the constant model (behind [`Stepper`]), the [`State`], the
 //! [`Loads`], a backup of the state taken before every communication step,
-//! and the [`Outputs`] of the last good step.
+//! and the [`Outputs`] of the last good step. The outputs that cost more
+//! than the reduced state (node positions and velocities, the energy of
+//! every spring, the force residual) are computed when first asked for
+//! after a step and kept until the state changes: a host that reads only
+//! some of them, or reads them less often than it steps, pays only for
+//! those (`docs/method.md`, section 4).
 
 use super::bake::SetupData;
 use super::basis::BasisOptions;
@@ -78,6 +83,14 @@ pub fn internal_step_count(h: f64, dt_max: f64) -> f64 {
     (h / dt_max * (1.0 - STEP_COUNT_TOLERANCE)).ceil().max(1.0)
 }
 
+/// Which of the costly outputs have been computed for the current state.
+#[derive(Clone, Copy, Debug, Default)]
+struct Fresh {
+    nodes: bool,
+    potential: bool,
+    residual: bool,
+}
+
 pub struct Simulator {
     engine: Box<dyn Stepper>,
     solver: SolverParams,
@@ -87,6 +100,11 @@ pub struct Simulator {
     /// if it fails (the loads do not change within a step).
     backup: State,
     outputs: Outputs,
+    /// Which of the costly outputs match the state.
+    fresh: Fresh,
+    /// Kinetic energy plus |potential energy as the force model sums it| of
+    /// the state, for the blow-up guard of the next step [J].
+    energy: f64,
     internal_steps_last: usize,
     /// Mass of the free nodes and the distance they can travel, for the blow-up bound.
     free_mass: f64,
@@ -119,6 +137,8 @@ impl Simulator {
         engine.settle(loads, &mut state);
         let mut sim = Simulator {
             outputs: Outputs::new(engine.scene(), solver.n_modes),
+            fresh: Fresh::default(),
+            energy: 0.0,
             backup: state.clone(),
             state,
             engine,
@@ -175,7 +195,7 @@ impl Simulator {
         }
         let steps = steps as usize;
         let dt = h / steps as f64;
-        let energy_before = self.outputs.kinetic + self.outputs.potential.abs();
+        let energy_before = self.energy;
         self.backup.copy_from(&self.state);
         let mut result = Ok(());
         for _ in 0..steps {
@@ -210,8 +230,21 @@ impl Simulator {
         Ok(())
     }
 
+    /// After every change of the state or the loads: the cheap outputs and
+    /// the guard's energy now, the costly ones when asked for.
     fn refresh_outputs(&mut self) {
-        self.engine.outputs(&self.loads, &self.state, &mut self.outputs);
+        self.fresh = Fresh::default();
+        self.outputs.kinetic = self.engine.kinetic_energy(&self.state);
+        self.engine.modal_coordinates(&self.state, &mut self.outputs.modal_coordinates);
+        self.energy = self.outputs.kinetic + self.engine.model_energy(&self.loads, &self.state).abs();
+    }
+
+    fn node_outputs(&mut self) -> &Outputs {
+        if !self.fresh.nodes {
+            self.engine.node_outputs(&self.state, &mut self.outputs);
+            self.fresh.nodes = true;
+        }
+        &self.outputs
     }
 
     /// The scene being simulated.
@@ -226,13 +259,15 @@ impl Simulator {
     pub fn n_dofs(&self) -> usize {
         self.scene().n_dofs()
     }
-    /// Node positions, `dim` per node in the scene's output order, held nodes included [m].
-    pub fn positions(&self) -> &[f64] {
-        &self.outputs.positions
+    /// Node positions, `dim` per node in the scene's output order, held
+    /// nodes included [m]. The modal space expands them from q when first
+    /// asked after a step.
+    pub fn positions(&mut self) -> &[f64] {
+        &self.node_outputs().positions
     }
     /// Node velocities, same layout as positions [m/s].
-    pub fn velocities(&self) -> &[f64] {
-        &self.outputs.velocities
+    pub fn velocities(&mut self) -> &[f64] {
+        &self.node_outputs().velocities
     }
     /// Coordinates of the kept (modal) or reported (full) modes.
     pub fn modal_coordinates(&self) -> &[f64] {
@@ -268,13 +303,23 @@ impl Simulator {
     pub fn kinetic_energy(&self) -> f64 {
         self.outputs.kinetic
     }
-    /// Elastic energy of the springs plus gravitational energy relative to rest [J].
-    pub fn potential_energy(&self) -> f64 {
+    /// Elastic energy of the springs plus gravitational energy relative to
+    /// rest [J]: every spring, whatever the force model; computed when first
+    /// asked after a step.
+    pub fn potential_energy(&mut self) -> f64 {
+        if !self.fresh.potential {
+            self.outputs.potential = self.engine.potential_energy(&self.loads, &self.state);
+            self.fresh.potential = true;
+        }
         self.outputs.potential
     }
     /// The part of the physical force the basis cannot represent, relative
-    /// to the load (0 in full space).
-    pub fn force_residual(&self) -> f64 {
+    /// to the load (0 in full space); computed when first asked after a step.
+    pub fn force_residual(&mut self) -> f64 {
+        if !self.fresh.residual {
+            self.outputs.force_residual = self.engine.force_residual(&self.loads, &self.state);
+            self.fresh.residual = true;
+        }
         self.outputs.force_residual
     }
     pub fn loads(&self) -> &Loads {

@@ -111,6 +111,14 @@ pub trait Space: Send + Sized + 'static {
     fn elastic_energy(&self, y: &[f64], w: &mut Self::Work) -> f64;
     /// Potential of gravity relative to the linearization point at y [J].
     fn gravity_potential(&self, loads: &Loads, y: &[f64], w: &Self::Work) -> f64;
+    /// The potential energy whose gradient the space integrates, at y, the
+    /// coordinates of the last [`Space::force`] [J]: elastic energy plus
+    /// gravity potential, with the elastic part as the force model sums it
+    /// (every spring; the cubature's weighted springs, which costs no more
+    /// than one of its steps). The step guard weighs energy growth with it.
+    fn model_energy(&self, loads: &Loads, y: &[f64], w: &mut Self::Work) -> f64 {
+        self.elastic_energy(y, w) + self.gravity_potential(loads, y, w)
+    }
     /// 1/2 v^T M v in physical space [J].
     fn kinetic_energy(&self, v: &[f64]) -> f64;
     /// Velocities of the free DOFs.

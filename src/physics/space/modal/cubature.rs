@@ -79,6 +79,8 @@ pub struct Cubature {
     l0: Vec<f64>,
     /// c = F0 - sum w p_e(0).
     offset: Vec<f64>,
+    /// U(0) - sum w U_e(0): the model's energy equals every spring's at q = 0.
+    energy_offset: f64,
     /// Every spring, for the outputs at communication points.
     exact: SpringForces,
     /// Relative error of F - F0 on the training poses and on the held-out ones.
@@ -96,6 +98,8 @@ pub struct CubatureWork {
     f: Vec<f64>,
     elastic: f64,
     springs: SpringScratch,
+    /// `x` is the expansion of the current q; `f` and `elastic` are its forces and energy.
+    x_valid: bool,
     exact_valid: bool,
     /// D x r scratch of the tangent.
     kg: Vec<f64>,
@@ -130,12 +134,14 @@ impl ReducedForce for Cubature {
             f: vec![0.0; modes.basis.n],
             elastic: 0.0,
             springs: self.exact.scratch(scene),
+            x_valid: false,
             exact_valid: false,
             kg: vec![0.0; scene.dim * modes.basis.r],
         }
     }
 
     fn project(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &mut CubatureWork, out: &mut [f64]) {
+        w.x_valid = false;
         w.exact_valid = false;
         match scene.dim {
             2 => self.project_d::<2>(modes.basis.r, q, w, out),
@@ -150,14 +156,29 @@ impl ReducedForce for Cubature {
         }
     }
 
-    fn positions<'w>(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &'w mut CubatureWork) -> &'w [f64] {
-        self.evaluate_exact(scene, modes, q, w);
+    fn positions<'w>(&self, _scene: &Scene, modes: &Modes, q: &[f64], w: &'w mut CubatureWork) -> &'w [f64] {
+        Self::expand(modes, q, w);
         &w.x
     }
 
     fn elastic_energy(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &mut CubatureWork) -> f64 {
         self.evaluate_exact(scene, modes, q, w);
         w.elastic
+    }
+
+    /// U~(q) = U(0) - c^T q + sum_S w_e (U_e(q) - U_e(0)), U_e = 1/2 k (l - l0)^2:
+    /// the energy whose negative gradient is F~ (-dU_e/dq = G^T g_e), from
+    /// the kept springs' vectors of the last evaluation.
+    fn model_energy(&self, scene: &Scene, _modes: &Modes, q: &[f64], w: &mut CubatureWork) -> f64 {
+        let springs: f64 =
+            w.d.chunks_exact(scene.dim)
+                .zip(self.wk.iter().zip(&self.l0))
+                .map(|(v, (&wk, &l0))| {
+                    let l = v.iter().map(|c| c * c).sum::<f64>().sqrt();
+                    0.5 * wk * (l - l0) * (l - l0)
+                })
+                .sum();
+        self.energy_offset - self.offset.iter().zip(q).map(|(c, q)| c * q).sum::<f64>() + springs
     }
 
     fn spring_forces<'w>(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &'w mut CubatureWork) -> &'w [f64] {
@@ -187,12 +208,20 @@ impl ReducedForce for Cubature {
 }
 
 impl Cubature {
+    /// x* + Phi q, once per state.
+    fn expand(modes: &Modes, q: &[f64], w: &mut CubatureWork) {
+        if !w.x_valid {
+            modes.expand(q, &mut w.x);
+            w.x_valid = true;
+        }
+    }
+
     /// The positions, forces and energy of every spring at q, once per state.
     fn evaluate_exact(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &mut CubatureWork) {
         if w.exact_valid {
             return;
         }
-        modes.expand(q, &mut w.x);
+        Self::expand(modes, q, w);
         w.f.fill(0.0);
         w.elastic = self.exact.add_to(scene, &w.x, &mut w.springs, &mut w.f);
         w.exact_valid = true;
@@ -335,7 +364,7 @@ fn train<const D: usize>(scene: &Scene, modes: &Modes, setup: &ForceSetup) -> Re
         exact.add_to(scene, &x, &mut scratch, &mut f);
         modes.project(&f, out);
     };
-    let f0 = exact_at_point(scene, modes, &exact);
+    let (f0, _) = exact_at_point(scene, modes, &exact);
 
     let (train_poses, held_poses) = poses(scene, modes, setup, &mut reduced)?;
     // F(q_t) - F0 per pose
@@ -451,24 +480,25 @@ fn train<const D: usize>(scene: &Scene, modes: &Modes, setup: &ForceSetup) -> Re
     })
 }
 
-/// F(0) = Phi^T f(x*), exactly, in the same passes a training pose takes.
-fn exact_at_point(scene: &Scene, modes: &Modes, exact: &SpringForces) -> Vec<f64> {
+/// F(0) = Phi^T f(x*), exactly, in the same passes a training pose takes,
+/// and the elastic energy of every spring there.
+fn exact_at_point(scene: &Scene, modes: &Modes, exact: &SpringForces) -> (Vec<f64>, f64) {
     let mut x = modes.point.clone();
     let mut f = vec![0.0; modes.basis.n];
     let r = modes.basis.r;
     modes.expand(&vec![0.0; r], &mut x);
-    exact.add_to(scene, &x, &mut exact.scratch(scene), &mut f);
+    let energy = exact.add_to(scene, &x, &mut exact.scratch(scene), &mut f);
     let mut out = vec![0.0; r];
     modes.project(&f, &mut out);
-    out
+    (out, energy)
 }
 
-/// The model of a spring set: each kept spring's G and d0, and
-/// c = F0 - sum w p_e(0).
+/// The model of a spring set: each kept spring's G and d0,
+/// c = F0 - sum w p_e(0), and the energy constant U(0) - sum w U_e(0).
 fn assemble<const D: usize>(scene: &Scene, modes: &Modes, set: SpringSet) -> Cubature {
     let r = modes.basis.r;
     let exact = SpringForces::new(scene);
-    let offset = exact_at_point(scene, modes, &exact);
+    let (offset, energy_at_point) = exact_at_point(scene, modes, &exact);
     let mut cub = Cubature {
         ids: Vec::new(),
         g: Vec::new(),
@@ -477,6 +507,7 @@ fn assemble<const D: usize>(scene: &Scene, modes: &Modes, set: SpringSet) -> Cub
         wk: Vec::new(),
         l0: Vec::new(),
         offset,
+        energy_offset: energy_at_point,
         exact,
         training_error: set.training_error,
         held_out_error: set.held_out_error,
@@ -490,6 +521,8 @@ fn assemble<const D: usize>(scene: &Scene, modes: &Modes, set: SpringSet) -> Cub
         cub.weights.push(w);
         cub.wk.push(w * c.k);
         cub.l0.push(c.l0);
+        let l = c.d0.iter().map(|v| v * v).sum::<f64>().sqrt();
+        cub.energy_offset -= 0.5 * w * c.k * (l - c.l0) * (l - c.l0);
         for j in 0..r {
             // c -= w p_e(0) = w G^T g(d0)
             cub.offset[j] -= w * (0..D).map(|m| c.g[m * r + j] * c.f0[m]).sum::<f64>();
@@ -599,18 +632,56 @@ mod tests {
     use crate::physics::space::ForceOptions;
     use crate::scenes;
 
+    /// A cubature model of `name` on 6 load modes with a static correction.
+    fn model(name: &str) -> (Scene, Modes, Cubature) {
+        let setup = scenes::canonical(name).unwrap();
+        let scene = setup.grid.build().unwrap();
+        let options = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest };
+        let built = basis::build(&scene, &setup.loads, 6, &options).unwrap();
+        let modes = Modes::new(built.modes, built.point, built.at_rest);
+        let bound = super::super::taut_reduced_bound(&scene, &modes.basis).unwrap();
+        let force = ForceOptions { evaluation: ForceEvaluation::Cubature, cubature_tolerance: 0.002 };
+        let cub = Cubature::new(&scene, &modes, &ForceSetup { loads: &setup.loads, options: &force, omega_sq_bound: bound, prebuilt: None }).unwrap();
+        (scene, modes, cub)
+    }
+
+    /// Central differences of the model energy U~ against the force F~ =
+    /// -dU~/dq, and U~(0) against the energy of every spring at q = 0.
+    #[test]
+    fn the_force_is_minus_the_gradient_of_the_model_energy() {
+        for name in ["paper-2d-top-row", "paper-3d-sheet"] {
+            let (scene, modes, cub) = model(name);
+            let mut w = cub.work(&scene, &modes);
+            let r = modes.basis.r;
+            let zero = vec![0.0; r];
+            let mut f = vec![0.0; r];
+            cub.project(&scene, &modes, &zero, &mut w, &mut f);
+            let (model0, exact0) = (cub.model_energy(&scene, &modes, &zero, &mut w), cub.elastic_energy(&scene, &modes, &zero, &mut w));
+            assert!((model0 - exact0).abs() <= 1e-9 * exact0.abs().max(1e-12), "{name}: U~(0) = {model0}, U(0) = {exact0}");
+            let q: Vec<f64> = (0..r).map(|j| 0.3 * (j as f64 + 1.0).sin()).collect();
+            cub.project(&scene, &modes, &q, &mut w, &mut f);
+            let scale = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let h = 1e-6;
+            for j in 0..r {
+                let (mut qp, mut qm) = (q.clone(), q.clone());
+                qp[j] += h;
+                qm[j] -= h;
+                let mut scratch = vec![0.0; r];
+                cub.project(&scene, &modes, &qp, &mut w, &mut scratch);
+                let up = cub.model_energy(&scene, &modes, &qp, &mut w);
+                cub.project(&scene, &modes, &qm, &mut w, &mut scratch);
+                let um = cub.model_energy(&scene, &modes, &qm, &mut w);
+                let fd = -(up - um) / (2.0 * h);
+                assert!((fd - f[j]).abs() <= 1e-6 * scale, "{name}: F~[{j}] = {} against -dU~/dq = {fd}", f[j]);
+            }
+        }
+    }
+
     /// Central differences of F~ against the tangent -dF~/dq it reports.
     #[test]
     fn the_tangent_is_the_derivative_of_the_force() {
         for name in ["paper-2d-top-row", "paper-3d-sheet"] {
-            let setup = scenes::canonical(name).unwrap();
-            let scene = setup.grid.build().unwrap();
-            let options = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest };
-            let built = basis::build(&scene, &setup.loads, 6, &options).unwrap();
-            let modes = Modes::new(built.modes, built.point, built.at_rest);
-            let bound = super::super::taut_reduced_bound(&scene, &modes.basis).unwrap();
-            let force = ForceOptions { evaluation: ForceEvaluation::Cubature, cubature_tolerance: 0.002 };
-            let cub = Cubature::new(&scene, &modes, &ForceSetup { loads: &setup.loads, options: &force, omega_sq_bound: bound, prebuilt: None }).unwrap();
+            let (scene, modes, cub) = model(name);
             let mut w = cub.work(&scene, &modes);
             let r = modes.basis.r;
             let q: Vec<f64> = (0..r).map(|j| 0.3 * (j as f64 + 1.0).sin()).collect();

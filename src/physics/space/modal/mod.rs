@@ -56,6 +56,12 @@ pub trait ReducedForce: Send + Sized + 'static {
     fn positions<'w>(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &'w mut Self::Work) -> &'w [f64];
     /// Elastic energy of every spring at `q`, the coordinates of the last [`Self::project`] [J].
     fn elastic_energy(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &mut Self::Work) -> f64;
+    /// The elastic energy whose negative gradient [`Self::project`] returns,
+    /// at `q`, the coordinates of the last [`Self::project`] [J]; the energy
+    /// of every spring unless the model sums fewer.
+    fn model_energy(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &mut Self::Work) -> f64 {
+        self.elastic_energy(scene, modes, q, w)
+    }
     /// The exact spring forces of every spring on the free DOFs at `q`, the
     /// coordinates of the last [`Self::project`] (for the error indicator).
     fn spring_forces<'w>(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &'w mut Self::Work) -> &'w [f64];
@@ -372,6 +378,10 @@ impl<F: ReducedForce> Space for Modal<F> {
 
     fn elastic_energy(&self, q: &[f64], w: &mut Self::Work) -> f64 {
         self.force.elastic_energy(&self.scene, &self.modes, q, &mut w.force)
+    }
+
+    fn model_energy(&self, loads: &Loads, q: &[f64], w: &mut Self::Work) -> f64 {
+        self.force.model_energy(&self.scene, &self.modes, q, &mut w.force) + self.gravity_potential(loads, q, w)
     }
 
     /// -(M g)^T (x - x_rest) = -(M g)^T (x* - x_rest) - (Phi^T M g)^T q.
