@@ -19,8 +19,10 @@
 //!   Φᵀ M Φ = I, Φᵀ K Φ = diag(λ) hold as for eigenmodes. The number of
 //!   modes counts every basis vector.
 
+use faer::linalg::matmul::matmul;
+use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Mat, Side};
+use faer::{Accum, Col, Mat, MatMut, MatRef, Par, Side};
 
 use super::equilibrium::equilibrium;
 use super::error::PhysicsError;
@@ -125,7 +127,7 @@ pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, options: &BasisOption
             }
             vectors.extend((eigen..candidates.r).map(|j| columns(&candidates, j)));
         }
-        rayleigh_ritz(scene, &pattern, &stiffness, &vectors, n_modes)?
+        orthonormal_ritz(scene, &pattern, &stiffness, &vectors, n_modes)?
     };
     Ok(Basis { point, at_rest, pattern, stiffness, modes })
 }
@@ -180,76 +182,133 @@ fn load_ritz(
 ) -> Result<ModalBasis, PhysicsError> {
     let solver = ShiftedStiffness::new(scene, pattern, stiffness)?;
     let mass = &scene.dof_mass;
-    let mut vectors: Vec<Vec<f64>> = Vec::new();
+    let mut basis = MOrthonormal::new(mass, m);
     let mut block: Vec<Vec<f64>> = patterns.iter().map(|f| solver.solve(f)).collect();
     block.extend(start.map(|u| u.to_vec()));
-    while vectors.len() < m && !block.is_empty() {
+    while !basis.full() && !block.is_empty() {
         let mut next = Vec::new();
         for v in block {
-            if let Some(q) = orthonormalized(&vectors, v, mass) {
+            if let Some(q) = basis.push(&v) {
                 let mq: Vec<f64> = q.iter().zip(mass).map(|(a, b)| a * b).collect();
                 next.push(solver.solve(&mq));
-                vectors.push(q);
-                if vectors.len() == m {
+                if basis.full() {
                     break;
                 }
             }
         }
         block = next;
     }
-    let r = vectors.len();
-    rayleigh_ritz(scene, pattern, stiffness, &vectors, r)
+    let r = basis.len();
+    rayleigh_ritz(pattern, stiffness, basis.columns(), r)
 }
 
-/// `v` made M-orthogonal to the M-orthonormal `basis` (twice, for round-off)
-/// and M-normalized; `None` if nothing of it is left.
-fn orthonormalized(basis: &[Vec<f64>], mut v: Vec<f64>, mass: &[f64]) -> Option<Vec<f64>> {
-    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).zip(mass).map(|((x, y), m)| x * m * y).sum::<f64>();
-    let norm0 = dot(&v, &v).sqrt();
-    if !(norm0 > 0.0 && norm0.is_finite()) {
-        return None;
+/// An M-orthonormal set of columns grown one vector at a time: classical
+/// Gram-Schmidt against all columns so far, twice ("twice is enough"), as
+/// faer's matrix-vector products Qᵀ (M v) and v − Q c.
+struct MOrthonormal<'a> {
+    mass: &'a [f64],
+    q: Mat<f64>,
+    k: usize,
+    /// Scratch: M v.
+    mv: Col<f64>,
+}
+
+impl<'a> MOrthonormal<'a> {
+    fn new(mass: &'a [f64], capacity: usize) -> Self {
+        MOrthonormal { mass, q: Mat::zeros(mass.len(), capacity), k: 0, mv: Col::zeros(mass.len()) }
     }
-    for _ in 0..2 {
-        for q in basis {
-            let c = dot(q, &v);
-            for (vi, qi) in v.iter_mut().zip(q) {
-                *vi -= c * qi;
+
+    fn len(&self) -> usize {
+        self.k
+    }
+
+    fn full(&self) -> bool {
+        self.k == self.q.ncols()
+    }
+
+    /// The columns so far.
+    fn columns(&self) -> MatRef<'_, f64> {
+        self.q.as_ref().subcols(0, self.k)
+    }
+
+    /// Adds what of `v` is M-orthogonal to the columns, M-normalized, and
+    /// returns it; `None` (nothing added) if the set is full or less than
+    /// [`DEPENDENT`] of `v`'s M-norm is left.
+    fn push(&mut self, v: &[f64]) -> Option<&[f64]> {
+        if self.full() {
+            return None;
+        }
+        let (n, k, mass) = (self.mass.len(), self.k, self.mass);
+        let m_norm = |x: &[f64]| x.iter().zip(mass).map(|(a, m)| m * a * a).sum::<f64>().sqrt();
+        let norm0 = m_norm(v);
+        if !(norm0 > 0.0 && norm0.is_finite()) {
+            return None;
+        }
+        let (done, mut rest) = self.q.as_mut().split_at_col_mut(k);
+        let mut x = rest.rb_mut().col_mut(0);
+        for (i, &vi) in v.iter().enumerate() {
+            x[i] = vi;
+        }
+        let mut norm = norm0;
+        if k > 0 {
+            let mut c = Col::<f64>::zeros(k);
+            for _ in 0..2 {
+                for i in 0..n {
+                    self.mv[i] = mass[i] * x[i];
+                }
+                matmul(c.as_mat_mut(), Accum::Replace, done.rb().transpose(), self.mv.as_mat(), 1.0, Par::Seq);
+                matmul(x.rb_mut().as_mat_mut(), Accum::Add, done.rb(), c.as_mat(), -1.0, Par::Seq);
+                // A pass that keeps more than 1/sqrt(2) of the norm leaves x
+                // orthogonal to working precision (Kahan and Parlett); else once more.
+                let before = norm;
+                norm = m_norm(x.rb().try_as_col_major().expect("contiguous").as_slice());
+                if norm > std::f64::consts::FRAC_1_SQRT_2 * before {
+                    break;
+                }
             }
         }
+        let slice = x.try_as_col_major_mut().expect("contiguous").as_slice_mut();
+        if !(norm > DEPENDENT * norm0) {
+            return None;
+        }
+        slice.iter_mut().for_each(|a| *a /= norm);
+        self.k += 1;
+        Some(self.q.col(k).try_as_col_major().expect("contiguous").as_slice())
     }
-    let norm = dot(&v, &v).sqrt();
-    if norm <= DEPENDENT * norm0 {
-        return None;
-    }
-    v.iter_mut().for_each(|x| *x /= norm);
-    Some(v)
 }
 
 /// The first `r` independent directions of `vectors` (in their order),
-/// M-orthonormalized, then diagonalized in their span: Φ = Q Z with
-/// Zᵀ (Qᵀ K Q) Z = diag(λ), Zᵀ Z = I.
-fn rayleigh_ritz(scene: &Scene, pattern: &StiffnessPattern, stiffness: &[f64], vectors: &[Vec<f64>], r: usize) -> Result<ModalBasis, PhysicsError> {
-    let n = scene.n_dofs();
-    let mut q: Vec<Vec<f64>> = Vec::with_capacity(r);
+/// M-orthonormalized ([`MOrthonormal`]), then diagonalized in their span
+/// ([`rayleigh_ritz`]).
+fn orthonormal_ritz(scene: &Scene, pattern: &StiffnessPattern, stiffness: &[f64], vectors: &[Vec<f64>], r: usize) -> Result<ModalBasis, PhysicsError> {
+    let mut q = MOrthonormal::new(&scene.dof_mass, r);
     for v in vectors {
-        if q.len() == r {
+        if q.full() {
             break;
         }
-        if let Some(u) = orthonormalized(&q, v.clone(), &scene.dof_mass) {
-            q.push(u);
-        }
+        q.push(v);
     }
     if q.len() < r {
         return Err(PhysicsError::BasisDeficient { wanted: r, found: q.len() });
     }
-    let mut kq = vec![0.0; n];
-    let mut kr = Mat::<f64>::zeros(r, r);
+    rayleigh_ritz(pattern, stiffness, q.columns(), r)
+}
+
+/// The M-orthonormal columns Q (n x r) diagonalized in their span: Φ = Q Z
+/// with Zᵀ (Qᵀ K Q) Z = diag(λ), Zᵀ Z = I. K Q column by column, the two
+/// dense products Qᵀ (K Q) and Q Z by faer, and faer's self-adjoint eigen
+/// decomposition of the r x r matrix.
+fn rayleigh_ritz(pattern: &StiffnessPattern, stiffness: &[f64], q: MatRef<'_, f64>, r: usize) -> Result<ModalBasis, PhysicsError> {
+    let n = q.nrows();
+    debug_assert_eq!(q.ncols(), r);
+    let mut kq = Mat::<f64>::zeros(n, r);
     for j in 0..r {
-        pattern.sym_matvec(stiffness, &q[j], &mut kq);
-        for i in 0..r {
-            kr[(i, j)] = q[i].iter().zip(&kq).map(|(a, b)| a * b).sum::<f64>();
-        }
+        let x = q.col(j).try_as_col_major().expect("contiguous").as_slice();
+        pattern.sym_matvec(stiffness, x, kq.col_mut(j).try_as_col_major_mut().expect("contiguous").as_slice_mut());
     }
+    let mut kr = Mat::<f64>::zeros(r, r);
+    matmul(kr.as_mut(), Accum::Replace, q.transpose(), kq.as_ref(), 1.0, Par::Seq);
+    drop(kq);
     // Symmetrize the round-off away before the symmetric solver reads one triangle.
     for j in 0..r {
         for i in 0..j {
@@ -272,12 +331,9 @@ fn rayleigh_ritz(scene: &Scene, pattern: &StiffnessPattern, stiffness: &[f64], v
         }
         lambda.push(l);
     }
+    // Φ row-major (n x r) is Φᵀ = Zᵀ Qᵀ column-major (r x n).
     let mut phi = vec![0.0; n * r];
-    for i in 0..n {
-        for j in 0..r {
-            phi[i * r + j] = (0..r).map(|c| q[c][i] * z[(c, j)]).sum::<f64>();
-        }
-    }
+    matmul(MatMut::from_column_major_slice_mut(&mut phi, r, n), Accum::Replace, z.transpose(), q.transpose(), 1.0, Par::Seq);
     Ok(ModalBasis { n, r, lambda, phi })
 }
 
