@@ -760,7 +760,10 @@ fn write_readme(out: &str, study: &Study, reference_notes: &str) {
          only, from rest; run time is the median of up to {repeats} run(s) from one set-up (runs over {TIME_ONCE_S} s timed once), \
          wall time per simulated second, set-up (assembly, eigen decomposition, equilibrium, cubature training) apart; a run still \
          going after {budget_s} s of wall time is stopped and listed as over budget. Error E is docs/method.md, section 6 against a \
-         full-space explicit Newmark reference at a tiny step; output times every {FRAME} s. A run reads the node positions at          every output time, as a host that draws or couples them would, and nothing else: outputs nobody reads are not computed          (`forceResidual`, which visits every spring, is read at the output times for the study outside the timing). `vs_full` in the CSV is E of a modal \
+         full-space explicit Newmark reference at a tiny step; output times every {FRAME} s. A run reads the node positions at every output \
+         time, as a host that draws or couples them would, and nothing else: outputs nobody reads are not computed \
+         (`forceResidual`, which visits every spring, is read at the output times for the study outside the timing). \
+         `vs_full` in the CSV is E of a modal \
          run against the full-space run with the same integrator and step. Speed-ups, mode counts and targets judge E over the \
          window the reference resolves (`error_resolved`, see References; the whole run except on cloth-3d-100x100).\n",
         if quick { " --quick" } else { "" },
