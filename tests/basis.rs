@@ -59,7 +59,13 @@ fn load_selection_leaves_out_what_gravity_does_not_excite() {
 #[test]
 fn ritz_vectors_are_mass_orthonormal_and_diagonalise_k() {
     for (scene, lin) in
-        [("paper-2d-top-row", Linearization::Rest), ("paper-2d-top-corners", Linearization::Equilibrium), ("paper-3d-sheet", Linearization::Rest)]
+        // cloth-3d (2 610 free DOFs) ranks load-dependent Ritz vectors, the others every mode.
+        [
+            ("paper-2d-top-row", Linearization::Rest),
+            ("paper-2d-top-corners", Linearization::Equilibrium),
+            ("paper-3d-sheet", Linearization::Rest),
+            ("cloth-3d", Linearization::Rest),
+        ]
     {
         let o = options(ModeSelection::Load, true, lin);
         let (s, b) = build(scene, 8, &o);
