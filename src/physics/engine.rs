@@ -53,9 +53,10 @@ pub trait Stepper: Send {
     fn model_energy(&mut self, loads: &Loads, state: &State) -> f64;
     /// Coordinates of the kept or reported modes.
     fn modal_coordinates(&self, state: &State, out: &mut [f64]);
-    /// Node positions and velocities of `state` (whose forces were
-    /// evaluated last) into `out`.
-    fn node_outputs(&mut self, state: &State, out: &mut Outputs);
+    /// Node positions of `state` (whose forces were evaluated last) into `out.positions`.
+    fn node_positions(&mut self, state: &State, out: &mut Outputs);
+    /// Node velocities of `state` into `out.velocities` (held nodes stay at 0).
+    fn node_velocities(&mut self, state: &State, out: &mut Outputs);
     /// Elastic energy of every spring plus gravity potential at `state` [J].
     fn potential_energy(&mut self, loads: &Loads, state: &State) -> f64;
     /// The force the space cannot represent at `state`, relative to the load.
@@ -181,14 +182,21 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
         self.space.modal_coordinates(&state.y, out);
     }
 
-    fn node_outputs(&mut self, state: &State, out: &mut Outputs) {
-        let space = &self.space;
-        let scene = space.scene();
-        space.dof_velocities(&state.v, &mut out.dof_velocities);
-        let x = space.positions(&state.y, &mut self.work);
+    fn node_positions(&mut self, state: &State, out: &mut Outputs) {
+        let scene = self.space.scene();
+        let x = self.space.positions(&state.y, &mut self.work);
         match scene.dim {
-            2 => to_node_order::<2>(&scene.slot_of_node, scene.n_free, x, &out.dof_velocities, &mut out.positions, &mut out.velocities),
-            _ => to_node_order::<3>(&scene.slot_of_node, scene.n_free, x, &out.dof_velocities, &mut out.positions, &mut out.velocities),
+            2 => to_node_order::<2>(&scene.slot_of_node, usize::MAX, x, &mut out.positions),
+            _ => to_node_order::<3>(&scene.slot_of_node, usize::MAX, x, &mut out.positions),
+        }
+    }
+
+    fn node_velocities(&mut self, state: &State, out: &mut Outputs) {
+        let scene = self.space.scene();
+        self.space.dof_velocities(&state.v, &mut out.dof_velocities);
+        match scene.dim {
+            2 => to_node_order::<2>(&scene.slot_of_node, scene.n_free, &out.dof_velocities, &mut out.velocities),
+            _ => to_node_order::<3>(&scene.slot_of_node, scene.n_free, &out.dof_velocities, &mut out.velocities),
         }
     }
 
@@ -201,15 +209,14 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
     }
 }
 
-/// Slot-ordered positions and free-DOF velocities into node order. Fixed
+/// Slot-ordered values into node order, for the nodes whose slot is below
+/// `limit` (the free slots for velocities; every slot for positions). Fixed
 /// length `D` keeps each copy a pair of moves instead of a `memmove` call.
-fn to_node_order<const D: usize>(slot_of_node: &[usize], n_free: usize, x: &[f64], v: &[f64], positions: &mut [f64], velocities: &mut [f64]) {
-    for ((&slot, p), vel) in slot_of_node.iter().zip(positions.chunks_exact_mut(D)).zip(velocities.chunks_exact_mut(D)) {
-        let xs: &[f64; D] = x[slot * D..slot * D + D].try_into().expect("D values");
-        *<&mut [f64; D]>::try_from(p).expect("D values") = *xs;
-        if slot < n_free {
-            let vs: &[f64; D] = v[slot * D..slot * D + D].try_into().expect("D values");
-            *<&mut [f64; D]>::try_from(vel).expect("D values") = *vs;
+fn to_node_order<const D: usize>(slot_of_node: &[usize], limit: usize, from: &[f64], to: &mut [f64]) {
+    for (&slot, t) in slot_of_node.iter().zip(to.chunks_exact_mut(D)) {
+        if slot < limit {
+            let f: &[f64; D] = from[slot * D..slot * D + D].try_into().expect("D values");
+            *<&mut [f64; D]>::try_from(t).expect("D values") = *f;
         }
     }
 }

@@ -86,7 +86,8 @@ pub fn internal_step_count(h: f64, dt_max: f64) -> f64 {
 /// Which of the costly outputs have been computed for the current state.
 #[derive(Clone, Copy, Debug, Default)]
 struct Fresh {
-    nodes: bool,
+    positions: bool,
+    velocities: bool,
     potential: bool,
     residual: bool,
 }
@@ -239,14 +240,6 @@ impl Simulator {
         self.energy = self.outputs.kinetic + self.engine.model_energy(&self.loads, &self.state).abs();
     }
 
-    fn node_outputs(&mut self) -> &Outputs {
-        if !self.fresh.nodes {
-            self.engine.node_outputs(&self.state, &mut self.outputs);
-            self.fresh.nodes = true;
-        }
-        &self.outputs
-    }
-
     /// The scene being simulated.
     pub fn scene(&self) -> &Scene {
         self.engine.scene()
@@ -263,11 +256,19 @@ impl Simulator {
     /// nodes included [m]. The modal space expands them from q when first
     /// asked after a step.
     pub fn positions(&mut self) -> &[f64] {
-        &self.node_outputs().positions
+        if !self.fresh.positions {
+            self.engine.node_positions(&self.state, &mut self.outputs);
+            self.fresh.positions = true;
+        }
+        &self.outputs.positions
     }
     /// Node velocities, same layout as positions [m/s].
     pub fn velocities(&mut self) -> &[f64] {
-        &self.node_outputs().velocities
+        if !self.fresh.velocities {
+            self.engine.node_velocities(&self.state, &mut self.outputs);
+            self.fresh.velocities = true;
+        }
+        &self.outputs.velocities
     }
     /// Coordinates of the kept (modal) or reported (full) modes.
     pub fn modal_coordinates(&self) -> &[f64] {
