@@ -198,13 +198,13 @@ fn load_ritz(
         }
         block = next;
     }
-    let r = basis.len();
-    rayleigh_ritz(pattern, stiffness, basis.columns(), r)
+    rayleigh_ritz(pattern, stiffness, basis.columns())
 }
 
 /// An M-orthonormal set of columns grown one vector at a time: classical
-/// Gram-Schmidt against all columns so far, twice ("twice is enough"), as
-/// faer's matrix-vector products Qᵀ (M v) and v − Q c.
+/// Gram-Schmidt against all columns so far, as faer's matrix-vector
+/// products Qᵀ (M v) and v − Q c, repeated once where the first pass left
+/// less than 1/√2 of the norm ("twice is enough", Kahan and Parlett).
 struct MOrthonormal<'a> {
     mass: &'a [f64],
     q: Mat<f64>,
@@ -258,8 +258,6 @@ impl<'a> MOrthonormal<'a> {
                 }
                 matmul(c.as_mat_mut(), Accum::Replace, done.rb().transpose(), self.mv.as_mat(), 1.0, Par::Seq);
                 matmul(x.rb_mut().as_mat_mut(), Accum::Add, done.rb(), c.as_mat(), -1.0, Par::Seq);
-                // A pass that keeps more than 1/sqrt(2) of the norm leaves x
-                // orthogonal to working precision (Kahan and Parlett); else once more.
                 let before = norm;
                 norm = m_norm(x.rb().try_as_col_major().expect("contiguous").as_slice());
                 if norm > std::f64::consts::FRAC_1_SQRT_2 * before {
@@ -267,11 +265,10 @@ impl<'a> MOrthonormal<'a> {
                 }
             }
         }
-        let slice = x.try_as_col_major_mut().expect("contiguous").as_slice_mut();
         if !(norm > DEPENDENT * norm0) {
             return None;
         }
-        slice.iter_mut().for_each(|a| *a /= norm);
+        x.try_as_col_major_mut().expect("contiguous").as_slice_mut().iter_mut().for_each(|a| *a /= norm);
         self.k += 1;
         Some(self.q.col(k).try_as_col_major().expect("contiguous").as_slice())
     }
@@ -291,16 +288,15 @@ fn orthonormal_ritz(scene: &Scene, pattern: &StiffnessPattern, stiffness: &[f64]
     if q.len() < r {
         return Err(PhysicsError::BasisDeficient { wanted: r, found: q.len() });
     }
-    rayleigh_ritz(pattern, stiffness, q.columns(), r)
+    rayleigh_ritz(pattern, stiffness, q.columns())
 }
 
 /// The M-orthonormal columns Q (n x r) diagonalized in their span: Φ = Q Z
 /// with Zᵀ (Qᵀ K Q) Z = diag(λ), Zᵀ Z = I. K Q column by column, the two
 /// dense products Qᵀ (K Q) and Q Z by faer, and faer's self-adjoint eigen
 /// decomposition of the r x r matrix.
-fn rayleigh_ritz(pattern: &StiffnessPattern, stiffness: &[f64], q: MatRef<'_, f64>, r: usize) -> Result<ModalBasis, PhysicsError> {
-    let n = q.nrows();
-    debug_assert_eq!(q.ncols(), r);
+fn rayleigh_ritz(pattern: &StiffnessPattern, stiffness: &[f64], q: MatRef<'_, f64>) -> Result<ModalBasis, PhysicsError> {
+    let (n, r) = (q.nrows(), q.ncols());
     let mut kq = Mat::<f64>::zeros(n, r);
     for j in 0..r {
         let x = q.col(j).try_as_col_major().expect("contiguous").as_slice();
