@@ -142,7 +142,7 @@ fn the_equilibrium_balances_gravity_and_matches_a_damped_run() {
         let setup = scenes::canonical(name).unwrap();
         let s = setup.grid.build().unwrap();
         let pattern = StiffnessPattern::new(&s);
-        let x = equilibrium(&s, &pattern, setup.loads.gravity).unwrap();
+        let x = equilibrium(&s, &pattern, &modal_mass_spring::physics::basis::external_load(&s, &setup.loads)).unwrap();
         let mut f: Vec<f64> = basis::load_patterns(&s, &setup.loads).remove(0);
         let gravity = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let springs = SpringForces::new(&s);

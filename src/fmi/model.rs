@@ -158,11 +158,31 @@ impl Params {
 
     pub fn loads(&self) -> Loads {
         let g = self.get(vr::GRAVITY);
+        let f = [self.scalar(vr::LOAD_X), self.scalar(vr::LOAD_Y), self.scalar(vr::LOAD_Z)];
         Loads {
             gravity: [g[0], g[1], g[2]],
+            point_load: f,
+            load_node: self.grid().node(self.count(vr::LOAD_ROW), self.count(vr::LOAD_COLUMN)),
             damping_alpha: self.scalar(vr::DAMPING_ALPHA),
             damping_beta: self.scalar(vr::DAMPING_BETA),
             mode_weights: self.get(vr::MODE_WEIGHTS).to_vec(),
+        }
+    }
+
+    /// Why the load node (loadRow, loadColumn) cannot carry the point load
+    /// in the grid these values describe: outside it, or held.
+    pub fn load_node_problem(&self) -> Option<String> {
+        let (row, col) = (self.count(vr::LOAD_ROW), self.count(vr::LOAD_COLUMN));
+        let grid = self.grid();
+        match grid.node(row, col) {
+            None => Some(format!(
+                "loadRow = {row}, loadColumn = {col} is outside the grid of ny = {} rows and nx = {} columns (set nx and ny first, or in the same call)",
+                grid.rows, grid.columns
+            )),
+            Some(node) if grid.is_held(node) => {
+                Some(format!("loadRow = {row}, loadColumn = {col} is a held node (fixedNodes = {}); choose a free node", grid.fixed_nodes.name()))
+            }
+            Some(_) => None,
         }
     }
 
@@ -195,6 +215,15 @@ pub fn computed(sim: &mut Simulator, vr: u32, time0: f64) -> Computed<'_> {
         vr::MODE_FREQUENCIES => Computed::Array(sim.mode_frequencies()),
         vr::FORCE_RESIDUAL => Computed::Scalar(sim.force_residual()),
         vr::CUBATURE_SPRINGS => Computed::Scalar(sim.cubature_springs() as f64),
+        vr::LOAD_NODE_X | vr::LOAD_NODE_Y | vr::LOAD_NODE_Z => Computed::Scalar(component(sim.load_node_position(), (vr - vr::LOAD_NODE_X) as usize)),
+        vr::LOAD_NODE_V_X | vr::LOAD_NODE_V_Y | vr::LOAD_NODE_V_Z => Computed::Scalar(component(sim.load_node_velocity(), (vr - vr::LOAD_NODE_V_X) as usize)),
+        vr::ANCHOR_FORCE_X | vr::ANCHOR_FORCE_Y | vr::ANCHOR_FORCE_Z => Computed::Scalar(sim.anchor_force()[(vr - vr::ANCHOR_FORCE_X) as usize]),
         _ => unreachable!("value reference {vr} is not computed"),
     }
+}
+
+/// Component `i` of a node vector: 0 past the scene's dimension (z in 2D),
+/// NaN when there is no such node.
+fn component(v: Option<&[f64]>, i: usize) -> f64 {
+    v.map_or(f64::NAN, |v| v.get(i).copied().unwrap_or(0.0))
 }

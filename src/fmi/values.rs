@@ -9,7 +9,7 @@ use super::instance::Instance;
 use super::model::{computed, Computed};
 use super::ptr::{slice, slice_mut, too_many};
 use super::state_machine::Mode;
-use super::variables::{index_of, Causality, Type, Variability, Variable, VARIABLES};
+use super::variables::{index_of, vr, Causality, Type, Variability, Variable, VARIABLES};
 use super::OK;
 
 type R = Result<fmi3Status, fmi3Status>;
@@ -202,6 +202,13 @@ impl Instance {
         }
         if self.params == old {
             return Ok(OK);
+        }
+        // The load node is checked against the grid when it is chosen.
+        if vrs.iter().any(|&r| r == vr::LOAD_ROW || r == vr::LOAD_COLUMN) {
+            if let Some(why) = self.params.load_node_problem() {
+                self.params = old;
+                return Err(self.log.fail(&format!("{}: refused: {why}", f.name())));
+            }
         }
         if self.mode == Mode::StepMode {
             // Only tunables and inputs get here; they act from the next step on.

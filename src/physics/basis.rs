@@ -69,14 +69,34 @@ pub struct Basis {
     pub modes: ModalBasis,
 }
 
-/// The load patterns the options rank and correct for: M g, when gravity is not zero.
+/// The load patterns the options rank and correct for: M g, when gravity
+/// is not zero, and the point load on its node, when it is not zero
+/// (`docs/method.md`, section 8).
 pub fn load_patterns(scene: &Scene, loads: &Loads) -> Vec<Vec<f64>> {
     let d = scene.dim;
     let g = &loads.gravity[..d];
-    if g.iter().all(|&x| x == 0.0) {
-        return Vec::new();
+    let mut patterns = Vec::new();
+    if g.iter().any(|&x| x != 0.0) {
+        patterns.push((0..scene.n_dofs()).map(|k| scene.dof_mass[k] * g[k % d]).collect());
     }
-    vec![(0..scene.n_dofs()).map(|k| scene.dof_mass[k] * g[k % d]).collect()]
+    if let Some((dof, f)) = loads.point_force(scene) {
+        let mut p = vec![0.0; scene.n_dofs()];
+        p[dof..dof + d].copy_from_slice(f);
+        patterns.push(p);
+    }
+    patterns
+}
+
+/// The external load on the free DOFs: M g plus the point load (`docs/method.md`, section 8).
+pub fn external_load(scene: &Scene, loads: &Loads) -> Vec<f64> {
+    let d = scene.dim;
+    let mut f: Vec<f64> = (0..scene.n_dofs()).map(|k| scene.dof_mass[k] * loads.gravity[k % d]).collect();
+    if let Some((dof, p)) = loads.point_force(scene) {
+        for (fk, pk) in f[dof..dof + d].iter_mut().zip(p) {
+            *fk += pk;
+        }
+    }
+    f
 }
 
 /// The basis of `n_modes` vectors `options` ask for on `scene` under `loads`.
@@ -88,7 +108,7 @@ pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, options: &BasisOption
     let pattern = StiffnessPattern::new(scene);
     let point = match options.linearization {
         Linearization::Rest => scene.rest.clone(),
-        Linearization::Equilibrium => equilibrium(scene, &pattern, loads.gravity)?,
+        Linearization::Equilibrium => equilibrium(scene, &pattern, &external_load(scene, loads))?,
     };
     let mut stiffness = vec![0.0; pattern.nnz()];
     pattern.add_tangent(scene, &point, 1.0, &mut stiffness);

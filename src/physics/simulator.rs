@@ -130,6 +130,7 @@ impl Simulator {
             return Err(PhysicsError::Invalid { quantity: Quantity::Modes, value: 0.0, expected: Expected::AtLeast(1.0) });
         }
         loads.validate(solver.n_modes)?;
+        loads.validate_on(&scene)?;
         let (free_mass, reach) = (scene.free_mass(), scene.reach());
         let mut engine = space::build(scene, solver, loads, prebuilt)?;
         engine.apply_loads(loads);
@@ -224,7 +225,9 @@ impl Simulator {
         }
         let kinetic = self.engine.kinetic_energy(&self.state);
         let g = self.loads.gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
-        let supply = self.free_mass * (g + 1.0) * self.reach * self.loads.weight_max();
+        // The point load does at most |f_p| times the reach on its node (`docs/method.md`, section 8).
+        let point = self.loads.active_point_load(self.scene().dim).map_or(0.0, |f| f.iter().map(|c| c * c).sum::<f64>().sqrt());
+        let supply = (self.free_mass * (g + 1.0) + point) * self.reach * self.loads.weight_max();
         if !(kinetic <= ENERGY_GROWTH_LIMIT * (energy_before + supply)) {
             return Err(StepFailure::EnergyGrowth { kinetic, before: energy_before, dt });
         }
@@ -269,6 +272,24 @@ impl Simulator {
             self.fresh.velocities = true;
         }
         &self.outputs.velocities
+    }
+    /// Position of the load node, `dim` values, if the node is in the
+    /// scene [m]; computed with the node positions.
+    pub fn load_node_position(&mut self) -> Option<&[f64]> {
+        let (node, d) = (self.loads.load_node.filter(|&n| n < self.scene().n_nodes)?, self.scene().dim);
+        Some(&self.positions()[node * d..node * d + d])
+    }
+    /// Velocity of the load node, `dim` values, if the node is in the scene [m/s].
+    pub fn load_node_velocity(&mut self) -> Option<&[f64]> {
+        let (node, d) = (self.loads.load_node.filter(|&n| n < self.scene().n_nodes)?, self.scene().dim);
+        Some(&self.velocities()[node * d..node * d + d])
+    }
+    /// The force the sheet exerts on its held nodes, the sum of the spring
+    /// forces acting on them (`docs/method.md`, section 8); z is 0 in 2D
+    /// [N]. Computed with the node positions.
+    pub fn anchor_force(&mut self) -> [f64; 3] {
+        self.positions();
+        self.outputs.anchor_force
     }
     /// Coordinates of the kept (modal) or reported (full) modes.
     pub fn modal_coordinates(&self) -> &[f64] {
@@ -341,6 +362,7 @@ impl Simulator {
             return Ok(());
         }
         loads.validate(self.solver.n_modes)?;
+        loads.validate_on(self.scene())?;
         self.loads.clone_from(loads);
         self.engine.apply_loads(&self.loads);
         self.engine.settle(&self.loads, &mut self.state);
@@ -366,6 +388,7 @@ impl Simulator {
             return Err(PhysicsError::SnapshotNotFinite);
         }
         s.loads.validate(self.solver.n_modes)?;
+        s.loads.validate_on(self.scene())?;
         self.loads.clone_from(&s.loads);
         self.engine.apply_loads(&self.loads);
         self.state.copy_from(&s.state);

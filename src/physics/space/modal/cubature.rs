@@ -545,7 +545,7 @@ fn fit<const D: usize>(chosen: &[(Candidate<D>, Vec<f64>, Vec<f64>)], target: &[
 }
 
 /// Training and held-out poses: every other sample of a short exact run of
-/// the reduced model under the set-up gravity (from the rest state, unit
+/// the reduced model under the set-up gravity and point load (from the rest state, unit
 /// weights, no damping, explicit Newmark at 0.9 of its stable step, one
 /// period of the slowest kept mode up to 2 s), and around them random poses
 /// q_start + s (q_t - q_start) + delta, s uniform in [0.5, 1.25], delta_j
@@ -558,10 +558,9 @@ fn poses(
     setup: &ForceSetup,
     reduced: &mut dyn FnMut(&[f64], &mut [f64]),
 ) -> Result<(Vec<Vec<f64>>, Vec<Vec<f64>>), PhysicsError> {
-    let (n, r, d) = (modes.basis.n, modes.basis.r, scene.dim);
+    let (n, r) = (modes.basis.n, modes.basis.r);
     let mut gravity = vec![0.0; r];
-    for k in 0..n {
-        let fk = scene.dof_mass[k] * setup.loads.gravity[k % d];
+    for (k, fk) in crate::physics::basis::external_load(scene, setup.loads).into_iter().enumerate() {
         for (j, gj) in gravity.iter_mut().enumerate() {
             *gj += modes.basis.phi[k * r + j] * fk;
         }

@@ -160,9 +160,9 @@ pub struct Modal<F: ReducedForce = Exact> {
 pub struct ModalWork<W> {
     /// c_i = alpha + beta lambda_i.
     damping: Vec<f64>,
-    /// Phi^T M g.
+    /// Phi^T (M g + f_p): gravity and the point load.
     gravity: Vec<f64>,
-    /// -(M g)^T (x* - x_rest): the gravity potential at q = 0.
+    /// -(M g + f_p)^T (x* - x_rest): the potential of the loads at q = 0.
     gravity_offset: f64,
     /// What the force model writes.
     force: W,
@@ -170,7 +170,7 @@ pub struct ModalWork<W> {
     kr: Vec<f64>,
     /// F = Phi^T (f + M g) of the last force evaluation, before the weights (for the error indicator).
     generalized: Vec<f64>,
-    /// ||M g||^2 in the M^-1 norm, the weight's scale of the error indicator.
+    /// ||M g + f_p||^2 in the M^-1 norm, the load's scale of the error indicator.
     load_scale: f64,
     /// Newton matrix, LU-factored in place, with its row permutation.
     jac: Mat<f64>,
@@ -299,6 +299,19 @@ impl<F: ReducedForce> Space for Modal<F> {
             }
             w.gravity_offset -= fk * (self.modes.point[k] - self.scene.rest[k]);
         }
+        // The point load joins M g: Phi^T f_p, its potential and its share of the load scale
+        // (`docs/method.md`, section 8). Skipped when zero, so runs without it are unchanged.
+        if let Some((dof, f)) = loads.point_force(&self.scene) {
+            for (i, &fi) in f.iter().enumerate() {
+                let k = dof + i;
+                for j in 0..r {
+                    w.gravity[j] += self.modes.basis.phi[k * r + j] * fi;
+                }
+                w.gravity_offset -= fi * (self.modes.point[k] - self.scene.rest[k]);
+                let mg = self.scene.dof_mass[k] * loads.gravity[k % d];
+                w.load_scale += ((mg + fi) * (mg + fi) - mg * mg) * self.inv_mass[k];
+            }
+        }
     }
 
     fn spring_force(&self, q: &[f64], w: &mut Self::Work, out: &mut [f64]) {
@@ -384,7 +397,7 @@ impl<F: ReducedForce> Space for Modal<F> {
         self.force.model_energy(&self.scene, &self.modes, q, &mut w.force) + self.gravity_potential(loads, q, w)
     }
 
-    /// -(M g)^T (x - x_rest) = -(M g)^T (x* - x_rest) - (Phi^T M g)^T q.
+    /// -(M g + f_p)^T (x - x_rest) = -(M g + f_p)^T (x* - x_rest) - (Phi^T (M g + f_p))^T q.
     fn gravity_potential(&self, _loads: &Loads, q: &[f64], w: &Self::Work) -> f64 {
         let modal = -w.gravity.iter().zip(q).map(|(g, q)| g * q).sum::<f64>();
         if self.modes.at_rest {
@@ -409,6 +422,14 @@ impl<F: ReducedForce> Space for Modal<F> {
             let t = fk + mass[k] * loads.gravity[k % d];
             total += t * t * inv_mass[k];
             spring += fk * fk * inv_mass[k];
+        }
+        if let Some((dof, f)) = loads.point_force(&self.scene) {
+            // The point load is part of the physical force on its node.
+            for (i, &fi) in f.iter().enumerate() {
+                let k = dof + i;
+                let t = springs[k] + mass[k] * loads.gravity[k % d];
+                total += ((t + fi) * (t + fi) - t * t) * inv_mass[k];
+            }
         }
         let held: f64 = w.generalized.iter().map(|f| f * f).sum();
         let scale = if w.load_scale > 0.0 { w.load_scale } else { spring };
