@@ -48,7 +48,7 @@ static GLOBAL: Counting = Counting;
 fn do_step_allocates_nothing() {
     WATCHED.with(|w| w.set(true));
     let paper = (BasisOptions::default(), ForceOptions::default());
-    let load = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest };
+    let load = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest, anchor_motion: false };
     let equilibrium = BasisOptions { linearization: Linearization::Equilibrium, ..load.clone() };
     let cubature = ForceOptions { evaluation: ForceEvaluation::Cubature, cubature_tolerance: 0.01 };
     let options = [

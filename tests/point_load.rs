@@ -74,7 +74,7 @@ fn at_rest_the_anchor_force_is_the_weight_plus_the_point_load() {
 fn with_load_modes_and_static_correction_the_anchor_force_is_close() {
     let rel_at = |scale: f64| {
         let mut solver = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 8);
-        solver.basis = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest };
+        solver.basis = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest, anchor_motion: false };
         let mut setup = scenes::canonical("paper-2d-top-row").unwrap().with_solver(solver);
         setup.loads.gravity = [0.0, -9.81 * scale, 0.0];
         setup.loads.point_load = LOAD.map(|f| f * scale);
@@ -163,7 +163,7 @@ fn a_point_load_needs_a_free_node_and_finite_values() {
 #[test]
 fn the_point_load_alone_is_a_load_pattern() {
     let mut solver = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 6);
-    solver.basis = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Equilibrium };
+    solver.basis = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Equilibrium, anchor_motion: false };
     let mut setup = scenes::canonical("paper-2d-top-row").unwrap().with_solver(solver);
     setup.loads.gravity = [0.0; 3];
     assert_eq!(setup.simulator().err(), Some(PhysicsError::NoLoad));
@@ -232,8 +232,8 @@ fn fmi_the_load_node_must_be_a_free_node_of_the_grid() {
     let f = Fmu::new();
     refused(&f, f.set_u64(vr::LOAD_ROW, 10), "loadRow = 10, loadColumn = 5 is outside the grid of ny = 10 rows");
     refused(&f, f.set_u64(vr::LOAD_COLUMN, 10), "outside the grid");
-    refused(&f, f.set_u64(vr::LOAD_ROW, 0), "loadRow = 0, loadColumn = 5 is a held node (fixedNodes = top-row)");
-    assert_eq!(f.get_u64(vr::LOAD_ROW), 9, "refused values are not stored");
+    refused(&f, f.set_u64(vr::LOAD_ROW, 9), "loadRow = 9, loadColumn = 5 is a held node (fixedNodes = top-row)");
+    assert_eq!(f.get_u64(vr::LOAD_ROW), 0, "refused values are not stored");
     assert_eq!(f.get_u64(vr::LOAD_COLUMN), 5);
     // Growing the grid first lets a farther node be chosen; nx, ny and loadRow in one call too.
     let (vrs, values) = ([vr::NY, vr::LOAD_ROW], [20u64, 15u64]);
@@ -241,26 +241,42 @@ fn fmi_the_load_node_must_be_a_free_node_of_the_grid() {
     assert_eq!(f.set_u64(vr::LOAD_ROW, 4), OK);
     f.init();
     f.expect_error(f.set_u64(vr::LOAD_ROW, 5), "fixed in Step Mode");
-    // Top corners: row 0 between the corners is free.
+    // Top corners: the top edge (row ny - 1 from the bottom) between the corners is free.
     let g = Fmu::new();
     assert_eq!(g.set_i64(vr::FIXED_NODES, 2), OK);
-    assert_eq!(g.set_u64(vr::LOAD_ROW, 0), OK, "{:?}", g.messages());
+    assert_eq!(g.set_u64(vr::LOAD_ROW, 9), OK, "{:?}", g.messages());
     refused(&g, g.set_u64(vr::LOAD_COLUMN, 0), "is a held node");
 }
 
-/// A smaller grid leaves the default load node outside it: harmless while
-/// the point load is zero (the load node outputs are NaN), refused once a
-/// load is set.
+/// The default load node is the middle of the bottom row of any grid:
+/// loadRow counts from the bottom edge and loadColumn follows nx / 2 until
+/// the host sets it. A column the host chose that a later nx leaves outside
+/// the grid is refused at set-up.
 #[test]
-fn fmi_a_default_load_node_outside_a_small_grid() {
+fn fmi_the_default_load_node_follows_the_grid() {
     let f = Fmu::new();
-    assert_eq!(f.set_u64(vr::NY, 4), OK);
+    let (vrs, values) = ([vr::NX, vr::NY], [5u64, 4u64]);
+    assert_eq!(unsafe { modal_mass_spring::fmi::exports::fmi3SetUInt64(f.inst, vrs.as_ptr(), 2, values.as_ptr(), 2) }, OK);
+    assert_eq!(f.get_u64(vr::LOAD_COLUMN), 2, "follows nx / 2");
     f.init();
     f.run(2, 0.01);
-    assert!(f.f64s(vr::LOAD_NODE_X, 1)[0].is_nan());
-    assert!(f.f64s(vr::ANCHOR_FORCE_Y, 1)[0] < 0.0);
-    let before = f.outputs();
-    refused(&f, f.set_f64(vr::LOAD_Y, &[-1.0]), "needs a free load node: loadRow = 9, loadColumn = 5 is outside the grid of ny = 4 rows");
-    assert_eq!(f.outputs(), before);
-    assert_eq!(f.f64s(vr::LOAD_Y, 1), vec![0.0]);
+    let positions = f.positions();
+    let node = 3 * 5 + 2; // row 3 from the top is the bottom row of 4
+    assert_eq!(f.f64s(vr::LOAD_NODE_X, 1)[0], positions[node * 2]);
+    assert_eq!(f.f64s(vr::LOAD_NODE_Y, 1)[0], positions[node * 2 + 1]);
+    assert_eq!(f.set_f64(vr::LOAD_Y, &[-1.0]), OK, "{:?}", f.messages());
+    f.run(1, 0.01);
+
+    // Chosen by the host, the column stays; set-up refuses it outside a narrower grid.
+    let g = Fmu::new();
+    assert_eq!(g.set_u64(vr::LOAD_COLUMN, 7), OK);
+    assert_eq!(g.set_u64(vr::NX, 20), OK);
+    assert_eq!(g.get_u64(vr::LOAD_COLUMN), 7, "a chosen column does not follow nx");
+    assert_eq!(g.set_u64(vr::NX, 6), OK);
+    use modal_mass_spring::fmi::exports::{fmi3EnterInitializationMode, fmi3ExitInitializationMode};
+    assert_eq!(unsafe { fmi3EnterInitializationMode(g.inst, false, 0.0, 0.0, false, 0.0) }, OK);
+    let status = unsafe { fmi3ExitInitializationMode(g.inst) };
+    let last = g.messages().last().cloned().unwrap_or_default();
+    assert!(last.contains("must be a free node of the grid: loadRow = 0, loadColumn = 7 is outside the grid"), "{last}");
+    assert_ne!(status, OK);
 }

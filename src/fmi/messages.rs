@@ -20,6 +20,7 @@ pub fn variable(q: Quantity) -> &'static str {
         Quantity::Modes => "nModes",
         Quantity::Gravity => "gravity",
         Quantity::PointLoad => "loadX, loadY, loadZ",
+        Quantity::Anchor => "anchorX, anchorY, anchorZ",
         Quantity::DampingAlpha => "dampingAlpha",
         Quantity::DampingBeta => "dampingBeta",
         Quantity::ModeWeights => "modeWeights",
@@ -74,7 +75,7 @@ pub fn describe(e: &PhysicsError, p: &Params) -> String {
                    set gravity or the point load before initialization, or use modeSelection = lowest without staticCorrection"
             .into(),
         LoadNode { .. } => format!(
-            "a non-zero point load (loadX, loadY, loadZ) needs a free load node: {}",
+            "the load node (loadRow, loadColumn) must be a free node of the grid: {}",
             p.load_node_problem().unwrap_or_else(|| format!("loadRow = {}, loadColumn = {}", p.scalar(vr::LOAD_ROW), p.scalar(vr::LOAD_COLUMN)))
         ),
         BasisDeficient { wanted, found } => format!("the basis has {found} independent vectors, nModes = {wanted}: keep fewer modes"),
@@ -120,6 +121,11 @@ pub fn describe(e: &PhysicsError, p: &Params) -> String {
 fn failure(cause: &StepFailure) -> String {
     match cause {
         StepFailure::NonFinite { .. } | StepFailure::EnergyGrowth { .. } | StepFailure::SingularNewton { .. } => cause.to_string(),
+        StepFailure::AnchorTooFast { speed, limit, dt } => format!(
+            "the anchor's velocity changes by {speed:e} m/s at the start of the step (anchorX, anchorY, anchorZ): the sheet would \
+             move relative to it by more than half the spacing per internal step of {dt:e} s (limit {limit:e} m/s); move the anchor \
+             in smaller steps, or lower maxInternalStep"
+        ),
         StepFailure::NewtonNotConverged { iterations, dt } => {
             format!("implicit Newmark: Newton did not converge in {iterations} iterations at dt = {dt:e} s; reduce maxInternalStep")
         }

@@ -146,6 +146,7 @@ impl Params {
                 selection: self.enumeration(vr::MODE_SELECTION, ModeSelection::from_value),
                 static_correction: self.scalar(vr::STATIC_CORRECTION) != 0.0,
                 linearization: self.enumeration(vr::LINEARIZATION, Linearization::from_value),
+                anchor_motion: self.scalar(vr::ANCHOR_MOTION) != 0.0,
             },
             force: ForceOptions {
                 evaluation: self.enumeration(vr::FORCE_EVALUATION, ForceEvaluation::from_value),
@@ -162,11 +163,20 @@ impl Params {
         Loads {
             gravity: [g[0], g[1], g[2]],
             point_load: f,
-            load_node: self.grid().node(self.count(vr::LOAD_ROW), self.count(vr::LOAD_COLUMN)),
+            load_node: self.load_node(),
+            anchor: [self.scalar(vr::ANCHOR_X), self.scalar(vr::ANCHOR_Y), self.scalar(vr::ANCHOR_Z)],
             damping_alpha: self.scalar(vr::DAMPING_ALPHA),
             damping_beta: self.scalar(vr::DAMPING_BETA),
             mode_weights: self.get(vr::MODE_WEIGHTS).to_vec(),
         }
+    }
+
+    /// The load node (loadRow counted from the bottom edge, loadColumn
+    /// from x = 0) as a node index in output order, if it is in the grid.
+    pub fn load_node(&self) -> Option<usize> {
+        let grid = self.grid();
+        let (row, col) = (self.count(vr::LOAD_ROW), self.count(vr::LOAD_COLUMN));
+        (row < grid.rows).then(|| grid.node(grid.rows - 1 - row, col)).flatten()
     }
 
     /// Why the load node (loadRow, loadColumn) cannot carry the point load
@@ -174,9 +184,9 @@ impl Params {
     pub fn load_node_problem(&self) -> Option<String> {
         let (row, col) = (self.count(vr::LOAD_ROW), self.count(vr::LOAD_COLUMN));
         let grid = self.grid();
-        match grid.node(row, col) {
+        match self.load_node() {
             None => Some(format!(
-                "loadRow = {row}, loadColumn = {col} is outside the grid of ny = {} rows and nx = {} columns (set nx and ny first, or in the same call)",
+                "loadRow = {row}, loadColumn = {col} is outside the grid of ny = {} rows and nx = {} columns (rows count from the bottom edge; set nx and ny first, or in the same call)",
                 grid.rows, grid.columns
             )),
             Some(node) if grid.is_held(node) => {
@@ -193,6 +203,9 @@ impl Params {
 
     /// Set-up with the costly part taken from a baked `prebuilt` when given.
     pub fn build_with(&self, prebuilt: Option<&SetupData>) -> Result<Simulator, PhysicsError> {
+        if self.load_node_problem().is_some() {
+            return Err(PhysicsError::LoadNode { node: self.load_node(), held: self.load_node().is_some() });
+        }
         Simulator::with_setup(self.grid().build()?, &self.solver(), &self.loads(), prebuilt)
     }
 }

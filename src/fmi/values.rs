@@ -200,7 +200,14 @@ impl Instance {
         if structure {
             self.params.fit_arrays();
         }
+        // The load node's column follows the middle of the bottom row until the host chooses it.
+        let chooses_column = vrs.contains(&vr::LOAD_COLUMN);
+        if !chooses_column && !self.load_column_chosen && vrs.contains(&vr::NX) {
+            let middle = (self.params.scalar(vr::NX) / 2.0).floor();
+            self.params.set(vr::LOAD_COLUMN, &[middle]);
+        }
         if self.params == old {
+            self.load_column_chosen |= chooses_column;
             return Ok(OK);
         }
         // The load node is checked against the grid when it is chosen.
@@ -210,6 +217,7 @@ impl Instance {
                 return Err(self.log.fail(&format!("{}: refused: {why}", f.name())));
             }
         }
+        self.load_column_chosen |= chooses_column;
         if self.mode == Mode::StepMode {
             // Only tunables and inputs get here; they act from the next step on.
             let loads = self.params.loads();

@@ -48,12 +48,15 @@ pub struct BasisOptions {
     pub selection: ModeSelection,
     pub static_correction: bool,
     pub linearization: Linearization,
+    /// The anchor will move: its inertial load along each axis, M e_i, is
+    /// a load pattern (`docs/method.md`, section 8).
+    pub anchor_motion: bool,
 }
 
 impl Default for BasisOptions {
     /// The paper's: the lowest modes at rest, no correction.
     fn default() -> Self {
-        BasisOptions { selection: ModeSelection::Lowest, static_correction: false, linearization: Linearization::Rest }
+        BasisOptions { selection: ModeSelection::Lowest, static_correction: false, linearization: Linearization::Rest, anchor_motion: false }
     }
 }
 
@@ -71,12 +74,18 @@ pub struct Basis {
 
 /// The load patterns the options rank and correct for: M g, when gravity
 /// is not zero, and the point load on its node, when it is not zero
-/// (`docs/method.md`, section 8).
-pub fn load_patterns(scene: &Scene, loads: &Loads) -> Vec<Vec<f64>> {
+/// (`docs/method.md`, section 8). With `anchor_motion` the inertial load of
+/// an anchor acceleration along each axis, M e_i, takes the place of M g
+/// (whose span it holds).
+pub fn load_patterns(scene: &Scene, loads: &Loads, anchor_motion: bool) -> Vec<Vec<f64>> {
     let d = scene.dim;
     let g = &loads.gravity[..d];
     let mut patterns = Vec::new();
-    if g.iter().any(|&x| x != 0.0) {
+    if anchor_motion {
+        for i in 0..d {
+            patterns.push((0..scene.n_dofs()).map(|k| if k % d == i { scene.dof_mass[k] } else { 0.0 }).collect());
+        }
+    } else if g.iter().any(|&x| x != 0.0) {
         patterns.push((0..scene.n_dofs()).map(|k| scene.dof_mass[k] * g[k % d]).collect());
     }
     if let Some((dof, f)) = loads.point_force(scene) {
@@ -113,7 +122,7 @@ pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, options: &BasisOption
     let mut stiffness = vec![0.0; pattern.nnz()];
     pattern.add_tangent(scene, &point, 1.0, &mut stiffness);
     let at_rest = options.linearization == Linearization::Rest;
-    let patterns = load_patterns(scene, loads);
+    let patterns = load_patterns(scene, loads, options.anchor_motion);
     let needs_load = options.selection == ModeSelection::Load || options.static_correction;
     if needs_load && patterns.is_empty() {
         return Err(PhysicsError::NoLoad);
@@ -144,6 +153,11 @@ pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, options: &BasisOption
             } else {
                 // At the equilibrium the sag is known exactly: the displacement from rest.
                 vectors.push((0..n).map(|k| point[k] - scene.rest[k]).collect());
+                if options.anchor_motion {
+                    // The anchor's inertial loads act around the equilibrium, through its tangent stiffness.
+                    let solver = ShiftedStiffness::new(scene, &pattern, &stiffness)?;
+                    vectors.extend(patterns.iter().take(scene.dim).map(|f| solver.solve(f)));
+                }
             }
             vectors.extend((eigen..candidates.r).map(|j| columns(&candidates, j)));
         }

@@ -46,6 +46,12 @@ pub trait Stepper: Send {
     fn spring_force(&mut self, loads: &Loads, state: &State, y: &[f64], out: &mut [f64]);
     /// One internal step of length `dt`.
     fn step(&mut self, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure>;
+    /// Adds the rates of a rigid translation with velocity `c` to
+    /// `state.v` (see [`Space::add_translation_rate`]) and sets `state.a`
+    /// for the new rates.
+    fn translate_rates(&mut self, loads: &Loads, c: &[f64; 3], state: &mut State);
+    /// Momentum of the free nodes per axis, relative to the anchor [kg m/s].
+    fn momentum(&self, state: &State) -> [f64; 3];
     /// Kinetic energy of `state` [J].
     fn kinetic_energy(&self, state: &State) -> f64;
     /// Potential energy of `state` as the force model sums it (see
@@ -217,6 +223,15 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
 
     fn step(&mut self, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure> {
         I::step(&self.space, &mut self.work, &mut self.buffers, loads, state, dt)
+    }
+
+    fn translate_rates(&mut self, loads: &Loads, c: &[f64; 3], state: &mut State) {
+        self.space.add_translation_rate(loads, c, &mut state.v);
+        self.settle(loads, state);
+    }
+
+    fn momentum(&self, state: &State) -> [f64; 3] {
+        self.space.momentum(&state.v)
     }
 
     fn kinetic_energy(&self, state: &State) -> f64 {

@@ -33,6 +33,7 @@ pub enum Quantity {
     Gravity,
     /// The force on the load node [N].
     PointLoad,
+    Anchor,
     /// Mass-proportional Rayleigh damping alpha [1/s].
     DampingAlpha,
     /// Stiffness-proportional Rayleigh damping beta [s].
@@ -60,6 +61,7 @@ impl Quantity {
             Quantity::Modes => "number of modes",
             Quantity::Gravity => "gravity",
             Quantity::PointLoad => "point load",
+            Quantity::Anchor => "anchor displacement",
             Quantity::DampingAlpha => "mass-proportional damping",
             Quantity::DampingBeta => "stiffness-proportional damping",
             Quantity::ModeWeights => "mode weights",
@@ -114,6 +116,10 @@ pub enum StepFailure {
     /// The full-space Newton matrix is singular even as LDL^T (springs in
     /// compression buckle).
     Buckled,
+    /// The anchor's velocity changes by `speed` at the start of the step:
+    /// the sheet would move relative to it by more than half the spacing in
+    /// one internal step of `dt` (`docs/method.md`, section 8).
+    AnchorTooFast { speed: f64, limit: f64, dt: f64 },
 }
 
 /// An error of the physics core.
@@ -202,6 +208,11 @@ impl fmt::Display for StepFailure {
             }
             StepFailure::SingularNewton { dt } => write!(f, "implicit Newmark: singular Newton matrix at dt = {dt:e} s"),
             StepFailure::Buckled => f.write_str("the full-space Newmark matrix is singular (springs in compression buckle); shorten the internal steps"),
+            StepFailure::AnchorTooFast { speed, limit, dt } => write!(
+                f,
+                "the anchor's velocity changes by {speed:e} m/s at the start of the step: the sheet would move relative to it by more \
+                 than half the spacing per internal step of {dt:e} s (limit {limit:e} m/s); move the anchor more smoothly"
+            ),
         }
     }
 }

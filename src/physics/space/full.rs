@@ -304,6 +304,22 @@ impl Space for Full {
         0.5 * v.iter().zip(&self.scene.dof_mass).map(|(v, m)| m * v * v).sum::<f64>()
     }
 
+    /// u' += 1 c on every free node.
+    fn add_translation_rate(&self, _loads: &Loads, c: &[f64; 3], v: &mut [f64]) {
+        let d = self.scene.dim;
+        for (k, vk) in v.iter_mut().enumerate() {
+            *vk += c[k % d];
+        }
+    }
+
+    fn momentum(&self, v: &[f64]) -> [f64; 3] {
+        let (d, mut p) = (self.scene.dim, [0.0; 3]);
+        for (k, (vk, m)) in v.iter().zip(&self.scene.dof_mass).enumerate() {
+            p[k % d] += m * vk;
+        }
+        p
+    }
+
     fn dof_velocities(&self, v: &[f64], out: &mut [f64]) {
         out.copy_from_slice(v);
     }

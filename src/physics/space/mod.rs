@@ -123,6 +123,13 @@ pub trait Space: Send + Sized + 'static {
     }
     /// 1/2 v^T M v in physical space [J].
     fn kinetic_energy(&self, v: &[f64]) -> f64;
+    /// Adds to the rates `v` those of a rigid translation of every free
+    /// node with velocity `c` (z is 0 in 2D), each coordinate scaled by its
+    /// weight like a load: the velocity kick of an anchor whose velocity
+    /// changes by -c (`docs/method.md`, section 8).
+    fn add_translation_rate(&self, loads: &Loads, c: &[f64; 3], v: &mut [f64]);
+    /// Momentum of the free nodes per axis, sum_k m_k v_k, at rates `v` [kg m/s].
+    fn momentum(&self, v: &[f64]) -> [f64; 3];
     /// Velocities of the free DOFs.
     fn dof_velocities(&self, v: &[f64], out: &mut [f64]);
     /// Coordinates of the kept or reported modes at y.

@@ -85,6 +85,8 @@ pub struct ForceSetup<'a> {
     /// The loads at set-up.
     pub loads: &'a Loads,
     pub options: &'a ForceOptions,
+    /// The anchor will move (see [`crate::physics::basis::BasisOptions::anchor_motion`]).
+    pub anchor_motion: bool,
     /// Squared-frequency bound of the reduced system with every spring (1/s^2).
     pub omega_sq_bound: f64,
     /// A stored set of springs and weights to use instead of computing one.
@@ -154,6 +156,9 @@ pub struct Modal<F: ReducedForce = Exact> {
     newton_scale: f64,
     /// 1 / m_k per free DOF.
     inv_mass: Vec<f64>,
+    /// Phi^T M e_i for each axis i (r x 3, row-major): the modal rates of a
+    /// unit rigid translation of the free nodes along axis i.
+    translation: Vec<f64>,
 }
 
 /// Load terms and scratch of a modal run.
@@ -206,11 +211,24 @@ impl<F: ReducedForce> Modal<F> {
         };
         let newton_scale = scene.free_mass().sqrt() * scene.length_scale().max(f64::MIN_POSITIVE);
         let frequencies = modes.basis.frequencies();
-        let setup = ForceSetup { loads, options: force_options, omega_sq_bound: bound, prebuilt: prebuilt.and_then(|d| d.cubature.as_ref()) };
+        let setup = ForceSetup {
+            loads,
+            options: force_options,
+            anchor_motion: options.anchor_motion,
+            omega_sq_bound: bound,
+            prebuilt: prebuilt.and_then(|d| d.cubature.as_ref()),
+        };
         let force = F::new(&scene, &modes, &setup)?;
         let omega_sq_bound = force.taut_bound(&scene, &modes).map_or(bound, |b| b.max(bound));
         let inv_mass = scene.dof_mass.iter().map(|m| 1.0 / m).collect();
-        Ok(Modal { force, frequencies, omega_sq_bound, bound, newton_scale, inv_mass, modes, scene })
+        let (n, r, d) = (modes.basis.n, modes.basis.r, scene.dim);
+        let mut translation = vec![0.0; r * 3];
+        for (j, col) in modes.cols.chunks_exact(n).enumerate() {
+            for (k, (p, m)) in col.iter().zip(&scene.dof_mass).enumerate() {
+                translation[j * 3 + k % d] += p * m;
+            }
+        }
+        Ok(Modal { force, frequencies, omega_sq_bound, bound, newton_scale, inv_mass, translation, modes, scene })
     }
 
     /// The kept modes.
@@ -443,6 +461,25 @@ impl<F: ReducedForce> Space for Modal<F> {
     /// 1/2 |q'|^2, since Phi^T M Phi = I.
     fn kinetic_energy(&self, v: &[f64]) -> f64 {
         0.5 * v.iter().map(|v| v * v).sum::<f64>()
+    }
+
+    /// q' += w_i Phi^T M (1 c): a rigid velocity c of the free nodes,
+    /// projected and weighted like every load.
+    fn add_translation_rate(&self, loads: &Loads, c: &[f64; 3], v: &mut [f64]) {
+        for (j, (vj, t)) in v.iter_mut().zip(self.translation.chunks_exact(3)).enumerate() {
+            *vj += loads.mode_weights[j] * (t[0] * c[0] + t[1] * c[1] + t[2] * c[2]);
+        }
+    }
+
+    /// sum_k m_k e_k (Phi q')_k = sum_j (Phi^T M e)_j q'_j per axis.
+    fn momentum(&self, v: &[f64]) -> [f64; 3] {
+        let mut p = [0.0; 3];
+        for (vj, t) in v.iter().zip(self.translation.chunks_exact(3)) {
+            for i in 0..3 {
+                p[i] += t[i] * vj;
+            }
+        }
+        p
     }
 
     /// Phi q'.
