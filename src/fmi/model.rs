@@ -203,10 +203,11 @@ impl Params {
 
     /// Set-up with the costly part taken from a baked `prebuilt` when given.
     pub fn build_with(&self, prebuilt: Option<&SetupData>) -> Result<Simulator, PhysicsError> {
+        let scene = self.grid().build()?;
         if self.load_node_problem().is_some() {
             return Err(PhysicsError::LoadNode { node: self.load_node(), held: self.load_node().is_some() });
         }
-        Simulator::with_setup(self.grid().build()?, &self.solver(), &self.loads(), prebuilt)
+        Simulator::with_setup(scene, &self.solver(), &self.loads(), prebuilt)
     }
 }
 
@@ -236,7 +237,7 @@ pub fn computed(sim: &mut Simulator, vr: u32, time0: f64) -> Computed<'_> {
 }
 
 /// Component `i` of a node vector: 0 past the scene's dimension (z in 2D),
-/// NaN when there is no such node.
+/// NaN when there is no such node (set-up refuses a load node outside the grid).
 fn component(v: Option<&[f64]>, i: usize) -> f64 {
     v.map_or(f64::NAN, |v| v.get(i).copied().unwrap_or(0.0))
 }

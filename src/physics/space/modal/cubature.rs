@@ -546,7 +546,7 @@ fn fit<const D: usize>(chosen: &[(Candidate<D>, Vec<f64>, Vec<f64>)], target: &[
 
 /// Training and held-out poses: every other sample of a short exact run of
 /// the reduced model under the set-up gravity and point load, and with
-/// `anchorMotion` the inertial load of an anchor accelerating at |g| (at least
+/// anchor motion ahead ([`ForceSetup::anchor_motion`]) the inertial load of an anchor accelerating at |g| (at least
 /// 1 m/s^2) along +x, +y and +z at once (from the rest state, unit
 /// weights, no damping, explicit Newmark at 0.9 of its stable step, one
 /// period of the slowest kept mode up to 2 s), and around them random poses
