@@ -69,7 +69,7 @@ fn cubature(c: &mut Criterion) {
         group.sample_size(20);
         for evaluation in [ForceEvaluation::Exact, ForceEvaluation::Cubature] {
             let mut s = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 16);
-            s.basis = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest };
+            s.basis = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest, anchor_motion: false };
             s.force = ForceOptions { evaluation, cubature_tolerance: 0.01 };
             let probe = setup.with_solver(s.clone()).simulator().unwrap();
             let dt = probe.max_stable_step().min(1e-3);

@@ -51,7 +51,7 @@ const LOAD_STATIC: usize = 2;
 fn variants() -> Vec<Variant> {
     use Linearization::{Equilibrium, Rest};
     use ModeSelection::{Load, Lowest};
-    let basis = |selection, static_correction, linearization| BasisOptions { selection, static_correction, linearization };
+    let basis = |selection, static_correction, linearization| BasisOptions { selection, static_correction, linearization, anchor_motion: false };
     let exact = ForceOptions { evaluation: ForceEvaluation::Exact, cubature_tolerance: CUBATURE_TOLERANCE };
     let cubature = ForceOptions { evaluation: ForceEvaluation::Cubature, cubature_tolerance: CUBATURE_TOLERANCE };
     let v = |key, label, basis, force| Variant { key, label, basis, force };

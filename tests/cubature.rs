@@ -12,7 +12,7 @@ use modal_mass_spring::scenes;
 
 fn solver(integrator: Integrator, r: usize, linearization: Linearization, force: ForceEvaluation, tolerance: f64) -> SolverParams {
     let mut s = SolverParams::new(Reduction::Modal, integrator, r);
-    s.basis = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization };
+    s.basis = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization, anchor_motion: false };
     s.force = ForceOptions { evaluation: force, cubature_tolerance: tolerance };
     s.max_internal_step = 0.001;
     s

@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 
 use fmi_schema::fmi3::Fmi3ModelDescription;
 use modal_mass_spring::fmi::model::Params;
-use modal_mass_spring::fmi::variables::{self, Type, VARIABLES};
+use modal_mass_spring::fmi::variables::{self, vr, Causality, Type, VARIABLES};
 use modal_mass_spring::options::{FixedNodes, Integrator};
 
 fn spec() -> generate::Spec {
@@ -134,7 +134,7 @@ fn defaults_are_paper_2d_top_row() {
 const WITH_INPUT: &str = r#"
 [[variables]]
 name = "push"
-vr = 40
+vr = 90
 type = "Float64"
 causality = "input"
 variability = "continuous"
@@ -144,7 +144,7 @@ description = "A test input"
 
 [[variables]]
 name = "reading"
-vr = 41
+vr = 91
 type = "Float64"
 causality = "output"
 variability = "continuous"
@@ -153,12 +153,20 @@ description = "An output that depends on no input directly"
 
 [[variables]]
 name = "echo"
-vr = 42
+vr = 92
 type = "Float64"
 causality = "output"
 variability = "continuous"
 depends_on = ["push"]
 description = "An output that depends on the input directly"
+
+[[variables]]
+name = "silent"
+vr = 93
+type = "Float64"
+causality = "output"
+variability = "continuous"
+description = "An output that declares no dependencies"
 "#;
 
 fn spec_with_input() -> Result<generate::Spec, String> {
@@ -171,12 +179,12 @@ fn spec_with_input() -> Result<generate::Spec, String> {
 fn inputs_are_generated_end_to_end() {
     let spec = spec_with_input().unwrap();
     let xml = spec.model_description_xml(&BTreeMap::new()).unwrap();
-    assert!(xml.contains(r#"name="push" valueReference="40" description="A test input" causality="input" variability="continuous""#), "{xml}");
+    assert!(xml.contains(r#"name="push" valueReference="90" description="A test input" causality="input" variability="continuous""#), "{xml}");
     assert!(attribute(&xml, "push", "start") == Some(0.0));
-    assert!(xml.contains(r#"<Output valueReference="41" dependencies=""/>"#), "{xml}");
-    assert!(xml.contains(r#"<Output valueReference="42" dependencies="40"/>"#), "{xml}");
+    assert!(xml.contains(r#"<Output valueReference="91" dependencies=""/>"#), "{xml}");
+    assert!(xml.contains(r#"<Output valueReference="92" dependencies="90"/>"#), "{xml}");
     // Outputs that declare nothing depend on every input.
-    assert!(xml.contains(r#"<Output valueReference="30"/>"#), "{xml}");
+    assert!(xml.contains(r#"<Output valueReference="93"/>"#), "{xml}");
     let md = fmi_rs::model_description::fmi3::ModelDescription::from_string(&xml).unwrap();
     let problems: Vec<String> = md.validate().into_iter().map(|p| p.message).collect();
     assert!(problems.is_empty(), "{problems:#?}");
@@ -186,13 +194,34 @@ fn inputs_are_generated_end_to_end() {
         assert!(problems.is_empty(), "{problems:#?}");
     }
     let rust = spec.rust_source();
-    assert!(rust.contains(r#"name: "push", vr: 40, ty: Type::Float64, causality: Causality::Input"#), "{rust}");
+    assert!(rust.contains(r#"name: "push", vr: 90, ty: Type::Float64, causality: Causality::Input"#), "{rust}");
     // An input is set by the host, so it has a start value and a place in startValues.txt.
     assert!(spec.start_values_text(&BTreeMap::new()).unwrap().contains("\npush 0.0\n"));
     let broken = WITH_INPUT.replacen("start = 0.0\n", "", 1);
     let text = std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("modelDescription/variables.toml")).unwrap();
     let (head, _) = text.split_once("\n[scenes.").unwrap();
     assert!(generate::parse(&format!("{head}\n{broken}")).unwrap_err().contains("push: parameters and inputs"));
+}
+
+/// The FMU's own inputs (the point load): every output says which of them
+/// it depends on directly, so chained FMUs see no algebraic loop where
+/// there is none. Positions, velocities and the anchor force follow the
+/// inputs only through the state; the potential energy and the force
+/// residual hold the point load's own term.
+#[test]
+fn every_output_declares_its_dependencies_on_the_point_load() {
+    let text = std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("modelDescription/variables.toml")).unwrap();
+    let spec = generate::parse(&text).unwrap();
+    let xml = spec.model_description_xml(&BTreeMap::new()).unwrap();
+    let direct = [vr::POTENTIAL_ENERGY, vr::FORCE_RESIDUAL];
+    let mut outputs = 0;
+    for v in VARIABLES.iter().filter(|v| v.causality == Causality::Output) {
+        let deps = if direct.contains(&v.vr) { format!("{} {} {}", vr::LOAD_X, vr::LOAD_Y, vr::LOAD_Z) } else { String::new() };
+        let want = format!(r#"<Output valueReference="{}" dependencies="{deps}"/>"#, v.vr);
+        assert!(xml.contains(&want), "{}: {want} not in the model description", v.name);
+        outputs += 1;
+    }
+    assert_eq!(outputs, 15);
 }
 
 #[test]

@@ -314,6 +314,9 @@ fn every_variable_in_every_state() {
             (Causality::StructuralParameter, _) => "ICR",
             (Causality::Parameter, Variability::Fixed) => "INR",
             (Causality::Parameter, Variability::Tunable) => "INSR",
+            // Inputs (FMI 3.0 Co-Simulation state machine): Instantiated, Initialization Mode, Step Mode
+            // (Event and Intermediate Update Mode, which this FMU has not, aside).
+            (Causality::Input, Variability::Continuous) => "INSR",
             (Causality::Independent | Causality::Output | Causality::CalculatedParameter, _) => NONE,
             other => panic!("{}: no rule for {other:?}", v.name),
         };

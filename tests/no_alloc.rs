@@ -1,5 +1,5 @@
 //! The stepping loop allocates nothing: a counting global allocator watches
-//! `do_step` and the reading of every output for every reduction and integrator once set-up is done. Only
+//! `do_step`, a change of the point load and the reading of every output for every reduction and integrator once set-up is done. Only
 //! allocations of the thread that steps count (the test harness's own
 //! threads allocate when they please).
 
@@ -48,7 +48,7 @@ static GLOBAL: Counting = Counting;
 fn do_step_allocates_nothing() {
     WATCHED.with(|w| w.set(true));
     let paper = (BasisOptions::default(), ForceOptions::default());
-    let load = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest };
+    let load = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest, anchor_motion: false };
     let equilibrium = BasisOptions { linearization: Linearization::Equilibrium, ..load.clone() };
     let cubature = ForceOptions { evaluation: ForceEvaluation::Cubature, cubature_tolerance: 0.01 };
     let options = [
@@ -67,17 +67,26 @@ fn do_step_allocates_nothing() {
                     solver.force = force.clone();
                     let mut setup = scenes::canonical(name).unwrap().with_solver(solver);
                     setup.loads.damping_beta = 1e-3; // exercises the factorised explicit velocity update too
+                                                     // A point load on the load node of the scene (a load pattern of the basis options too).
+                    setup.loads.point_load = [0.01, -0.02, 0.0];
                     let mut sim = setup.simulator().unwrap();
                     sim.do_step(0.01).unwrap(); // first step may factorise
+                    let mut loads = sim.loads().clone();
                     let before = ALLOCATIONS.load(Ordering::SeqCst);
                     for k in 0..20 {
                         sim.do_step(0.01).unwrap();
                         if k % 2 == 0 {
                             // The outputs computed on demand, read on every other step.
                             let x = sim.positions()[0] + sim.velocities()[0] + sim.potential_energy() + sim.force_residual();
+                            let x = x + sim.load_node_position().unwrap()[0] + sim.load_node_velocity().unwrap()[1] + sim.anchor_force()[1];
                             assert!(x.is_finite());
                         }
                     }
+                    // A load change between steps derives the load terms again, without allocating.
+                    loads.point_load = [-0.01, -0.03, 0.0];
+                    sim.set_loads(&loads).unwrap();
+                    sim.do_step(0.01).unwrap();
+                    assert!(sim.anchor_force()[1].is_finite());
                     let n = ALLOCATIONS.load(Ordering::SeqCst) - before;
                     assert_eq!(n, 0, "{name} {reduction:?} {integrator:?} {basis:?} {force:?}: {n} allocations in 20 steps and the outputs read");
                 }

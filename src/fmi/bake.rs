@@ -6,7 +6,8 @@
 //! bit-identical run; one whose values differ (or a file that is corrupt or
 //! from another build) computes the set-up and logs why.
 //!
-//! The key is every structural and fixed parameter and the set-up gravity,
+//! The key is every structural and fixed parameter, the set-up gravity and
+//! the set-up point load,
 //! except those set-up does not read ([`NOT_READ_BY_SETUP`]). File layout
 //! (little-endian): magic `MMSBAKE1`, the crate version (u32 length +
 //! bytes), the key (u32 count, then per variable u32 value reference, u32
@@ -23,12 +24,15 @@ const MAGIC: &[u8; 8] = b"MMSBAKE1";
 /// Fixed parameters the set-up of the basis and the cubature does not read.
 const NOT_READ_BY_SETUP: &[u32] = &[vr::INTEGRATOR, vr::MAX_INTERNAL_STEP];
 
+/// Tunable parameters and inputs whose values at set-up the basis reads.
+const SETUP_LOADS: &[u32] = &[vr::GRAVITY, vr::LOAD_X, vr::LOAD_Y, vr::LOAD_Z];
+
 /// The values the set-up depends on, by value reference.
 fn key(p: &Params) -> Vec<(u32, Vec<f64>)> {
     VARIABLES
         .iter()
         .enumerate()
-        .filter(|(_, v)| v.holds_value() && (v.variability == Variability::Fixed || v.vr == vr::GRAVITY) && !NOT_READ_BY_SETUP.contains(&v.vr))
+        .filter(|(_, v)| v.holds_value() && (v.variability == Variability::Fixed || SETUP_LOADS.contains(&v.vr)) && !NOT_READ_BY_SETUP.contains(&v.vr))
         .map(|(i, v)| (v.vr, p.values[i].clone()))
         .collect()
 }

@@ -38,6 +38,8 @@ pub struct Instance {
     pub(super) residual_warned: bool,
     /// The FMU's `resources/setup.bin`, if it has one.
     pub(super) baked: Option<Vec<u8>>,
+    /// The host set loadColumn; until then it follows the middle of the row (nx / 2).
+    pub(super) load_column_chosen: bool,
 }
 
 impl Instance {
@@ -56,6 +58,7 @@ impl Instance {
             states: OwnedStates::default(),
             residual_warned: false,
             baked: None,
+            load_column_chosen: false,
         }
     }
 

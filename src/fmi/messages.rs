@@ -19,6 +19,8 @@ pub fn variable(q: Quantity) -> &'static str {
         Quantity::MaxInternalStep => "maxInternalStep",
         Quantity::Modes => "nModes",
         Quantity::Gravity => "gravity",
+        Quantity::PointLoad => "loadX, loadY, loadZ",
+        Quantity::Anchor => "anchorX, anchorY, anchorZ",
         Quantity::DampingAlpha => "dampingAlpha",
         Quantity::DampingBeta => "dampingBeta",
         Quantity::ModeWeights => "modeWeights",
@@ -63,15 +65,19 @@ pub fn describe(e: &PhysicsError, p: &Params) -> String {
         NegativeEigenvalue { lambda } => format!("the stiffness matrix at rest has a negative eigenvalue {lambda}"),
         LinearAlgebra { .. } => e.to_string(),
         NoEquilibrium { load_fraction, residual } => format!(
-            "linearization = equilibrium: no static equilibrium found under gravity (Newton reached {load_fraction} of the load \
-             with a residual of {residual:.2e} of the gravity force); use linearization = rest, or less gravity"
+            "linearization = equilibrium: no static equilibrium found under gravity and the point load (Newton reached {load_fraction} of \
+             the load with a residual of {residual:.2e} of the largest load); use linearization = rest, or a smaller load"
         ),
-        UnstableEquilibrium => "linearization = equilibrium: every equilibrium found under gravity is unstable (its stiffness has a \
+        UnstableEquilibrium => "linearization = equilibrium: every equilibrium found under the loads is unstable (its stiffness has a \
                                 negative eigenvalue); use linearization = rest"
             .into(),
-        NoLoad => "modeSelection = load and staticCorrection = true build the basis from the loads at set-up, and gravity is zero: \
-                   set gravity before initialization, or use modeSelection = lowest without staticCorrection"
+        NoLoad => "modeSelection = load and staticCorrection = true build the basis from the loads at set-up, and gravity and the point load (loadX, loadY, loadZ) are zero: \
+                   set gravity or the point load before initialization, or use modeSelection = lowest without staticCorrection"
             .into(),
+        LoadNode { .. } => format!(
+            "the load node (loadRow, loadColumn) must be a free node of the grid: {}",
+            p.load_node_problem().unwrap_or_else(|| format!("loadRow = {}, loadColumn = {}", p.scalar(vr::LOAD_ROW), p.scalar(vr::LOAD_COLUMN)))
+        ),
         BasisDeficient { wanted, found } => format!("the basis has {found} independent vectors, nModes = {wanted}: keep fewer modes"),
         ExplicitTooStiff { stable_step, omega_max, stiffness_per_mass, per_step, max_internal_step, limit, modes } => {
             let kept = match modes {
@@ -115,6 +121,11 @@ pub fn describe(e: &PhysicsError, p: &Params) -> String {
 fn failure(cause: &StepFailure) -> String {
     match cause {
         StepFailure::NonFinite { .. } | StepFailure::EnergyGrowth { .. } | StepFailure::SingularNewton { .. } => cause.to_string(),
+        StepFailure::AnchorTooFast { speed, limit, dt } => format!(
+            "the anchor's velocity changes by {speed:e} m/s at the start of the step (anchorX, anchorY, anchorZ): the sheet would \
+             move relative to it by more than half the spacing per internal step of {dt:e} s (limit {limit:e} m/s); move the anchor \
+             in smaller steps, or lower maxInternalStep"
+        ),
         StepFailure::NewtonNotConverged { iterations, dt } => {
             format!("implicit Newmark: Newton did not converge in {iterations} iterations at dt = {dt:e} s; reduce maxInternalStep")
         }

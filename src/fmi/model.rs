@@ -146,6 +146,7 @@ impl Params {
                 selection: self.enumeration(vr::MODE_SELECTION, ModeSelection::from_value),
                 static_correction: self.scalar(vr::STATIC_CORRECTION) != 0.0,
                 linearization: self.enumeration(vr::LINEARIZATION, Linearization::from_value),
+                anchor_motion: self.scalar(vr::ANCHOR_MOTION) != 0.0,
             },
             force: ForceOptions {
                 evaluation: self.enumeration(vr::FORCE_EVALUATION, ForceEvaluation::from_value),
@@ -158,11 +159,40 @@ impl Params {
 
     pub fn loads(&self) -> Loads {
         let g = self.get(vr::GRAVITY);
+        let f = [self.scalar(vr::LOAD_X), self.scalar(vr::LOAD_Y), self.scalar(vr::LOAD_Z)];
         Loads {
             gravity: [g[0], g[1], g[2]],
+            point_load: f,
+            load_node: self.load_node(),
+            anchor: [self.scalar(vr::ANCHOR_X), self.scalar(vr::ANCHOR_Y), self.scalar(vr::ANCHOR_Z)],
             damping_alpha: self.scalar(vr::DAMPING_ALPHA),
             damping_beta: self.scalar(vr::DAMPING_BETA),
             mode_weights: self.get(vr::MODE_WEIGHTS).to_vec(),
+        }
+    }
+
+    /// The load node (loadRow counted from the bottom edge, loadColumn
+    /// from x = 0) as a node index in output order, if it is in the grid.
+    pub fn load_node(&self) -> Option<usize> {
+        let grid = self.grid();
+        let (row, col) = (self.count(vr::LOAD_ROW), self.count(vr::LOAD_COLUMN));
+        (row < grid.rows).then(|| grid.node(grid.rows - 1 - row, col)).flatten()
+    }
+
+    /// Why the load node (loadRow, loadColumn) cannot carry the point load
+    /// in the grid these values describe: outside it, or held.
+    pub fn load_node_problem(&self) -> Option<String> {
+        let (row, col) = (self.count(vr::LOAD_ROW), self.count(vr::LOAD_COLUMN));
+        let grid = self.grid();
+        match self.load_node() {
+            None => Some(format!(
+                "loadRow = {row}, loadColumn = {col} is outside the grid of ny = {} rows and nx = {} columns (rows count from the bottom edge; set nx and ny first, or in the same call)",
+                grid.rows, grid.columns
+            )),
+            Some(node) if grid.is_held(node) => {
+                Some(format!("loadRow = {row}, loadColumn = {col} is a held node (fixedNodes = {}); choose a free node", grid.fixed_nodes.name()))
+            }
+            Some(_) => None,
         }
     }
 
@@ -173,7 +203,11 @@ impl Params {
 
     /// Set-up with the costly part taken from a baked `prebuilt` when given.
     pub fn build_with(&self, prebuilt: Option<&SetupData>) -> Result<Simulator, PhysicsError> {
-        Simulator::with_setup(self.grid().build()?, &self.solver(), &self.loads(), prebuilt)
+        let scene = self.grid().build()?;
+        if self.load_node_problem().is_some() {
+            return Err(PhysicsError::LoadNode { node: self.load_node(), held: self.load_node().is_some() });
+        }
+        Simulator::with_setup(scene, &self.solver(), &self.loads(), prebuilt)
     }
 }
 
@@ -195,6 +229,15 @@ pub fn computed(sim: &mut Simulator, vr: u32, time0: f64) -> Computed<'_> {
         vr::MODE_FREQUENCIES => Computed::Array(sim.mode_frequencies()),
         vr::FORCE_RESIDUAL => Computed::Scalar(sim.force_residual()),
         vr::CUBATURE_SPRINGS => Computed::Scalar(sim.cubature_springs() as f64),
+        vr::LOAD_NODE_X | vr::LOAD_NODE_Y | vr::LOAD_NODE_Z => Computed::Scalar(component(sim.load_node_position(), (vr - vr::LOAD_NODE_X) as usize)),
+        vr::LOAD_NODE_V_X | vr::LOAD_NODE_V_Y | vr::LOAD_NODE_V_Z => Computed::Scalar(component(sim.load_node_velocity(), (vr - vr::LOAD_NODE_V_X) as usize)),
+        vr::ANCHOR_FORCE_X | vr::ANCHOR_FORCE_Y | vr::ANCHOR_FORCE_Z => Computed::Scalar(sim.anchor_force()[(vr - vr::ANCHOR_FORCE_X) as usize]),
         _ => unreachable!("value reference {vr} is not computed"),
     }
+}
+
+/// Component `i` of a node vector: 0 past the scene's dimension (z in 2D),
+/// NaN when there is no such node (set-up refuses a load node outside the grid).
+fn component(v: Option<&[f64]>, i: usize) -> f64 {
+    v.map_or(f64::NAN, |v| v.get(i).copied().unwrap_or(0.0))
 }

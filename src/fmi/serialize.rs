@@ -6,7 +6,7 @@
 //! | 4 | format version |
 //! | 8 | fingerprint of the variable layout |
 //! | 8 | payload length |
-//! | n | payload: mode, start time, stop time, every parameter and input (vr, length, values), simulator snapshot (time, y, y', y'', loads) |
+//! | n | payload: mode, start time, stop time, every parameter and input (vr, length, values), simulator snapshot (time, y, y', y'', anchor and its rate, loads: gravity, point load, load node, anchor target, damping, weights) |
 //! | 4 | CRC-32 (IEEE) of everything before |
 //!
 //! Decoding checks all of it and every value against the model description,
@@ -29,8 +29,9 @@ type R = Result<fmi3Status, fmi3Status>;
 pub const MAGIC: &[u8; 8] = b"MMSFMU3S";
 /// 1: FNV-1a checksum, no stop time; 2: CRC-32, stop time; 3: the
 /// simulator state as time and three arrays (y, y', y'') instead of one
-/// concatenated array.
-pub const VERSION: u32 = 3;
+/// concatenated array; 4: the point load and its node among the loads,
+/// the anchor's position and rate in the state and its target among the loads.
+pub const VERSION: u32 = 4;
 /// Bytes before the payload.
 pub const HEADER: usize = 8 + 4 + 8 + 8;
 /// Bytes after the payload.
@@ -84,8 +85,12 @@ pub fn payload(s: &FmuState) -> Vec<u8> {
             put_f64s(&mut p, &s.y);
             put_f64s(&mut p, &s.v);
             put_f64s(&mut p, &s.a);
+            s.anchor.iter().chain(&s.anchor_rate).for_each(|x| put_f64(&mut p, *x));
             let l = &snap.loads;
             l.gravity.iter().for_each(|g| put_f64(&mut p, *g));
+            l.point_load.iter().for_each(|f| put_f64(&mut p, *f));
+            put_u64(&mut p, l.load_node.map_or(u64::MAX, |n| n as u64));
+            l.anchor.iter().for_each(|a| put_f64(&mut p, *a));
             put_f64(&mut p, l.damping_alpha);
             put_f64(&mut p, l.damping_beta);
             put_f64s(&mut p, &l.mode_weights);
@@ -174,8 +179,19 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
     let snapshot = match r.u8()? {
         0 => None,
         1 => {
-            let state = State { time: r.f64()?, y: r.f64s()?, v: r.f64s()?, a: r.f64s()? };
+            let (time, y, v, a) = (r.f64()?, r.f64s()?, r.f64s()?, r.f64s()?);
+            let (anchor, anchor_rate) = ([r.f64()?, r.f64()?, r.f64()?], [r.f64()?, r.f64()?, r.f64()?]);
+            let state = State { time, y, v, a, anchor, anchor_rate };
             let gravity = [r.f64()?, r.f64()?, r.f64()?];
+            let point_load = [r.f64()?, r.f64()?, r.f64()?];
+            let load_node = match r.u64()? {
+                u64::MAX => None,
+                n => Some(usize::try_from(n).map_err(|_| "load node out of range".to_string())?),
+            };
+            let anchor = [r.f64()?, r.f64()?, r.f64()?];
+            if !anchor.iter().all(|a| a.is_finite()) {
+                return Err("the anchor target holds non-finite values".into());
+            }
             let damping_alpha = r.f64()?;
             let damping_beta = r.f64()?;
             let mode_weights = r.f64s()?;
@@ -185,7 +201,7 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
             if state.v.len() != state.y.len() || state.a.len() != state.y.len() {
                 return Err(format!("the simulator state holds arrays of {}, {} and {} values", state.y.len(), state.v.len(), state.a.len()));
             }
-            Some(Snapshot { state, loads: Loads { gravity, damping_alpha, damping_beta, mode_weights } })
+            Some(Snapshot { state, loads: Loads { gravity, point_load, load_node, anchor, damping_alpha, damping_beta, mode_weights } })
         }
         _ => return Err("bad snapshot flag".into()),
     };

@@ -116,6 +116,7 @@ impl Instance {
         self.start_time = 0.0;
         self.stop_time = None;
         self.residual_warned = false;
+        self.load_column_chosen = false;
         Ok(OK)
     }
 }

@@ -9,7 +9,7 @@ use super::instance::Instance;
 use super::model::{computed, Computed};
 use super::ptr::{slice, slice_mut, too_many};
 use super::state_machine::Mode;
-use super::variables::{index_of, Causality, Type, Variability, Variable, VARIABLES};
+use super::variables::{index_of, vr, Causality, Type, Variability, Variable, VARIABLES};
 use super::OK;
 
 type R = Result<fmi3Status, fmi3Status>;
@@ -200,9 +200,24 @@ impl Instance {
         if structure {
             self.params.fit_arrays();
         }
+        // The load node's column follows the middle of the bottom row until the host chooses it.
+        let chooses_column = vrs.contains(&vr::LOAD_COLUMN);
+        if !chooses_column && !self.load_column_chosen && vrs.contains(&vr::NX) {
+            let middle = (self.params.scalar(vr::NX) / 2.0).floor();
+            self.params.set(vr::LOAD_COLUMN, &[middle]);
+        }
         if self.params == old {
+            self.load_column_chosen |= chooses_column;
             return Ok(OK);
         }
+        // The load node is checked against the grid when it is chosen.
+        if vrs.iter().any(|&r| r == vr::LOAD_ROW || r == vr::LOAD_COLUMN) {
+            if let Some(why) = self.params.load_node_problem() {
+                self.params = old;
+                return Err(self.log.fail(&format!("{}: refused: {why}", f.name())));
+            }
+        }
+        self.load_column_chosen |= chooses_column;
         if self.mode == Mode::StepMode {
             // Only tunables and inputs get here; they act from the next step on.
             let loads = self.params.loads();

@@ -48,12 +48,15 @@ pub struct BasisOptions {
     pub selection: ModeSelection,
     pub static_correction: bool,
     pub linearization: Linearization,
+    /// The anchor will move: its inertial load along each axis, M e_i, is
+    /// a load pattern (`docs/method.md`, section 8).
+    pub anchor_motion: bool,
 }
 
 impl Default for BasisOptions {
     /// The paper's: the lowest modes at rest, no correction.
     fn default() -> Self {
-        BasisOptions { selection: ModeSelection::Lowest, static_correction: false, linearization: Linearization::Rest }
+        BasisOptions { selection: ModeSelection::Lowest, static_correction: false, linearization: Linearization::Rest, anchor_motion: false }
     }
 }
 
@@ -69,14 +72,40 @@ pub struct Basis {
     pub modes: ModalBasis,
 }
 
-/// The load patterns the options rank and correct for: M g, when gravity is not zero.
-pub fn load_patterns(scene: &Scene, loads: &Loads) -> Vec<Vec<f64>> {
+/// The load patterns the options rank and correct for: M g, when gravity
+/// is not zero, and the point load on its node, when it is not zero
+/// (`docs/method.md`, section 8). With `anchor_motion` the inertial load of
+/// an anchor acceleration along each axis, M e_i, takes the place of M g
+/// (whose span it holds).
+pub fn load_patterns(scene: &Scene, loads: &Loads, anchor_motion: bool) -> Vec<Vec<f64>> {
     let d = scene.dim;
     let g = &loads.gravity[..d];
-    if g.iter().all(|&x| x == 0.0) {
-        return Vec::new();
+    let mut patterns = Vec::new();
+    if anchor_motion {
+        for i in 0..d {
+            patterns.push((0..scene.n_dofs()).map(|k| if k % d == i { scene.dof_mass[k] } else { 0.0 }).collect());
+        }
+    } else if g.iter().any(|&x| x != 0.0) {
+        patterns.push((0..scene.n_dofs()).map(|k| scene.dof_mass[k] * g[k % d]).collect());
     }
-    vec![(0..scene.n_dofs()).map(|k| scene.dof_mass[k] * g[k % d]).collect()]
+    if let Some((dof, f)) = loads.point_force(scene) {
+        let mut p = vec![0.0; scene.n_dofs()];
+        p[dof..dof + d].copy_from_slice(f);
+        patterns.push(p);
+    }
+    patterns
+}
+
+/// The external load on the free DOFs: M g plus the point load (`docs/method.md`, section 8).
+pub fn external_load(scene: &Scene, loads: &Loads) -> Vec<f64> {
+    let d = scene.dim;
+    let mut f: Vec<f64> = (0..scene.n_dofs()).map(|k| scene.dof_mass[k] * loads.gravity[k % d]).collect();
+    if let Some((dof, p)) = loads.point_force(scene) {
+        for (fk, pk) in f[dof..dof + d].iter_mut().zip(p) {
+            *fk += pk;
+        }
+    }
+    f
 }
 
 /// The basis of `n_modes` vectors `options` ask for on `scene` under `loads`.
@@ -88,12 +117,12 @@ pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, options: &BasisOption
     let pattern = StiffnessPattern::new(scene);
     let point = match options.linearization {
         Linearization::Rest => scene.rest.clone(),
-        Linearization::Equilibrium => equilibrium(scene, &pattern, loads.gravity)?,
+        Linearization::Equilibrium => equilibrium(scene, &pattern, &external_load(scene, loads))?,
     };
     let mut stiffness = vec![0.0; pattern.nnz()];
     pattern.add_tangent(scene, &point, 1.0, &mut stiffness);
     let at_rest = options.linearization == Linearization::Rest;
-    let patterns = load_patterns(scene, loads);
+    let patterns = load_patterns(scene, loads, options.anchor_motion);
     let needs_load = options.selection == ModeSelection::Load || options.static_correction;
     if needs_load && patterns.is_empty() {
         return Err(PhysicsError::NoLoad);
@@ -124,6 +153,11 @@ pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, options: &BasisOption
             } else {
                 // At the equilibrium the sag is known exactly: the displacement from rest.
                 vectors.push((0..n).map(|k| point[k] - scene.rest[k]).collect());
+                if options.anchor_motion {
+                    // The anchor's inertial loads act around the equilibrium, through its tangent stiffness.
+                    let solver = ShiftedStiffness::new(scene, &pattern, &stiffness)?;
+                    vectors.extend(patterns.iter().take(scene.dim).map(|f| solver.solve(f)));
+                }
             }
             vectors.extend((eigen..candidates.r).map(|j| columns(&candidates, j)));
         }

@@ -46,6 +46,12 @@ pub trait Stepper: Send {
     fn spring_force(&mut self, loads: &Loads, state: &State, y: &[f64], out: &mut [f64]);
     /// One internal step of length `dt`.
     fn step(&mut self, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure>;
+    /// Adds the rates of a rigid translation with velocity `c` to
+    /// `state.v` (see [`Space::add_translation_rate`]) and sets `state.a`
+    /// for the new rates.
+    fn translate_rates(&mut self, loads: &Loads, c: &[f64; 3], state: &mut State);
+    /// Momentum of the free nodes per axis, relative to the anchor [kg m/s].
+    fn momentum(&self, state: &State) -> [f64; 3];
     /// Kinetic energy of `state` [J].
     fn kinetic_energy(&self, state: &State) -> f64;
     /// Potential energy of `state` as the force model sums it (see
@@ -53,7 +59,8 @@ pub trait Stepper: Send {
     fn model_energy(&mut self, loads: &Loads, state: &State) -> f64;
     /// Coordinates of the kept or reported modes.
     fn modal_coordinates(&self, state: &State, out: &mut [f64]);
-    /// Node positions of `state` (whose forces were evaluated last) into `out.positions`.
+    /// Node positions of `state` (whose forces were evaluated last) into
+    /// `out.positions`, and the anchor force (which follows from them).
     fn node_positions(&mut self, state: &State, out: &mut Outputs);
     /// Node velocities of `state` into `out.velocities` (held nodes stay at 0).
     fn node_velocities(&mut self, state: &State, out: &mut Outputs);
@@ -80,6 +87,9 @@ pub struct Outputs {
     pub potential: f64,
     /// The part of the force the space cannot represent, relative to the load.
     pub force_residual: f64,
+    /// The force the sheet exerts on its held nodes: the sum of the spring
+    /// forces acting on them (`docs/method.md`, section 8) [N]; z is 0 in 2D.
+    pub anchor_force: [f64; 3],
 }
 
 impl Outputs {
@@ -93,6 +103,7 @@ impl Outputs {
             kinetic: 0.0,
             potential: 0.0,
             force_residual: 0.0,
+            anchor_force: [0.0; 3],
         }
     }
 }
@@ -102,13 +113,57 @@ pub struct Engine<S: Space, I: Scheme> {
     space: S,
     work: S::Work,
     buffers: Buffers,
+    /// The springs with one end on a held node: (held slot, other slot,
+    /// stiffness, rest length), for the anchor force.
+    anchors: Vec<(usize, usize, f64, f64)>,
     scheme: PhantomData<I>,
 }
 
 impl<S: Space, I: Scheme> Engine<S, I> {
     pub fn new(space: S) -> Self {
-        Engine { work: space.work(), buffers: Buffers::new(space.coordinates()), space, scheme: PhantomData }
+        let anchors = anchor_springs(space.scene());
+        Engine { work: space.work(), buffers: Buffers::new(space.coordinates()), anchors, space, scheme: PhantomData }
     }
+}
+
+/// The springs of `scene` with one end on a held node (a node of the
+/// output that is not free; the anchor points of auxiliary springs are not
+/// nodes): (held slot, other slot, stiffness, rest length).
+fn anchor_springs(scene: &Scene) -> Vec<(usize, usize, f64, f64)> {
+    let mut held = vec![false; scene.rest.len() / scene.dim];
+    for &slot in &scene.slot_of_node {
+        held[slot] = slot >= scene.n_free;
+    }
+    let mut anchors = Vec::new();
+    for s in &scene.springs {
+        if held[s.a] {
+            anchors.push((s.a, s.b, s.k, s.rest));
+        }
+        if held[s.b] {
+            anchors.push((s.b, s.a, s.k, s.rest));
+        }
+    }
+    anchors
+}
+
+/// Sum over `anchors` of the force each spring exerts on its held end at
+/// slot positions `x`: k (l - l0) (x_other - x_held) / l.
+fn anchor_force(anchors: &[(usize, usize, f64, f64)], d: usize, x: &[f64]) -> [f64; 3] {
+    let mut f = [0.0; 3];
+    for &(held, other, k, rest) in anchors {
+        let mut diff = [0.0; 3];
+        for i in 0..d {
+            diff[i] = x[other * d + i] - x[held * d + i];
+        }
+        let l = diff.iter().map(|c| c * c).sum::<f64>().sqrt();
+        if l > 0.0 {
+            let t = k * (l - rest) / l;
+            for i in 0..d {
+                f[i] += t * diff[i];
+            }
+        }
+    }
+    f
 }
 
 impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
@@ -170,6 +225,15 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
         I::step(&self.space, &mut self.work, &mut self.buffers, loads, state, dt)
     }
 
+    fn translate_rates(&mut self, loads: &Loads, c: &[f64; 3], state: &mut State) {
+        self.space.add_translation_rate(loads, c, &mut state.v);
+        self.settle(loads, state);
+    }
+
+    fn momentum(&self, state: &State) -> [f64; 3] {
+        self.space.momentum(&state.v)
+    }
+
     fn kinetic_energy(&self, state: &State) -> f64 {
         self.space.kinetic_energy(&state.v)
     }
@@ -185,6 +249,7 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
     fn node_positions(&mut self, state: &State, out: &mut Outputs) {
         let scene = self.space.scene();
         let x = self.space.positions(&state.y, &mut self.work);
+        out.anchor_force = anchor_force(&self.anchors, scene.dim, x);
         match scene.dim {
             2 => to_node_order::<2>(&scene.slot_of_node, usize::MAX, x, &mut out.positions),
             _ => to_node_order::<3>(&scene.slot_of_node, usize::MAX, x, &mut out.positions),

@@ -1,6 +1,7 @@
-//! The static equilibrium of a scene under gravity (`docs/method.md`,
-//! section 3): the positions x of the free DOFs where the springs carry the
-//! load, f(x) + M g = 0.
+//! The static equilibrium of a scene under its loads (`docs/method.md`,
+//! sections 3 and 8): the positions x of the free DOFs where the springs
+//! carry the load, f(x) + M g + f_p = 0 (gravity and the point load; M g
+//! stands for both below).
 //!
 //! Newton's method on the full space, K(x) Δx = f(x) + s M g, with the load
 //! applied in increments s (0 → 1, halved when a Newton solve fails, doubled
@@ -35,7 +36,7 @@ const MAX_ITERATIONS: usize = 600;
 /// Smallest load increment tried before giving up.
 const MIN_INCREMENT: f64 = 1.0 / 4096.0;
 /// Converged when the largest residual force is below this fraction of the
-/// largest gravity force on a node.
+/// largest load on a DOF.
 const TOLERANCE: f64 = 1e-10;
 /// Unstable equilibria left along their most negative mode before giving up.
 const MAX_BUCKLINGS: usize = 8;
@@ -43,11 +44,11 @@ const MAX_BUCKLINGS: usize = 8;
 /// (in magnitude) count as zero, not negative.
 const ZERO_EIGENVALUE: f64 = 1e-10;
 
-/// Slot positions at the equilibrium of `scene` under `gravity` (the rest
-/// positions when gravity is zero).
-pub fn equilibrium(scene: &Scene, pattern: &StiffnessPattern, gravity: [f64; 3]) -> Result<Vec<f64>, PhysicsError> {
-    let (n, d) = (scene.n_dofs(), scene.dim);
-    let load: Vec<f64> = (0..n).map(|k| scene.dof_mass[k] * gravity[k % d]).collect();
+/// Slot positions at the equilibrium of `scene` under the external `load`
+/// on its free DOFs (M g plus the point load, [`super::basis::external_load`];
+/// the rest positions when the load is zero).
+pub fn equilibrium(scene: &Scene, pattern: &StiffnessPattern, load: &[f64]) -> Result<Vec<f64>, PhysicsError> {
+    let load = load.to_vec();
     let scale = load.iter().fold(0.0f64, |m, f| m.max(f.abs()));
     if scale == 0.0 {
         return Ok(scene.rest.clone());

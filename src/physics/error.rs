@@ -31,6 +31,9 @@ pub enum Quantity {
     Modes,
     /// Gravitational acceleration [m/s^2].
     Gravity,
+    /// The force on the load node [N].
+    PointLoad,
+    Anchor,
     /// Mass-proportional Rayleigh damping alpha [1/s].
     DampingAlpha,
     /// Stiffness-proportional Rayleigh damping beta [s].
@@ -57,6 +60,8 @@ impl Quantity {
             Quantity::MaxInternalStep => "internal step bound",
             Quantity::Modes => "number of modes",
             Quantity::Gravity => "gravity",
+            Quantity::PointLoad => "point load",
+            Quantity::Anchor => "anchor displacement",
             Quantity::DampingAlpha => "mass-proportional damping",
             Quantity::DampingBeta => "stiffness-proportional damping",
             Quantity::ModeWeights => "mode weights",
@@ -111,6 +116,10 @@ pub enum StepFailure {
     /// The full-space Newton matrix is singular even as LDL^T (springs in
     /// compression buckle).
     Buckled,
+    /// The anchor's velocity changes by `speed` at the start of the step:
+    /// the sheet would move relative to it by more than half the spacing in
+    /// one internal step of `dt` (`docs/method.md`, section 8).
+    AnchorTooFast { speed: f64, limit: f64, dt: f64 },
 }
 
 /// An error of the physics core.
@@ -141,12 +150,15 @@ pub enum PhysicsError {
     LinearAlgebra { what: &'static str, detail: String },
     /// No static equilibrium under the loads: Newton stopped at this
     /// fraction of the load, with this largest residual force relative to
-    /// the largest gravity force.
+    /// the largest load on a DOF.
     NoEquilibrium { load_fraction: f64, residual: f64 },
     /// Every equilibrium found is unstable (its stiffness has a negative eigenvalue).
     UnstableEquilibrium,
     /// A basis built from the loads, and the loads are zero.
     NoLoad,
+    /// A non-zero point load on a node that is held (`held`) or not in the
+    /// scene (`node` is the node index asked for, if any).
+    LoadNode { node: Option<usize>, held: bool },
     /// The candidate vectors span fewer independent directions than asked for.
     BasisDeficient { wanted: usize, found: usize },
     /// The explicit integrator would need more than `limit` internal steps
@@ -196,6 +208,11 @@ impl fmt::Display for StepFailure {
             }
             StepFailure::SingularNewton { dt } => write!(f, "implicit Newmark: singular Newton matrix at dt = {dt:e} s"),
             StepFailure::Buckled => f.write_str("the full-space Newmark matrix is singular (springs in compression buckle); shorten the internal steps"),
+            StepFailure::AnchorTooFast { speed, limit, dt } => write!(
+                f,
+                "the anchor's velocity changes by {speed:e} m/s at the start of the step: the sheet would move relative to it by more \
+                 than half the spacing per internal step of {dt:e} s (limit {limit:e} m/s); move the anchor more smoothly"
+            ),
         }
     }
 }
@@ -229,8 +246,8 @@ impl fmt::Display for PhysicsError {
             LinearAlgebra { what, detail } => write!(f, "{what} failed: {detail}"),
             NoEquilibrium { load_fraction, residual } => write!(
                 f,
-                "no static equilibrium found under gravity: Newton reached {load_fraction} of the load with a residual of \
-                 {residual:.2e} of the gravity force; linearize at rest"
+                "no static equilibrium found under the loads: Newton reached {load_fraction} of the load with a residual of \
+                 {residual:.2e} of the largest load; linearize at rest"
             ),
             CubatureNotReached { tolerance, reached, springs } => write!(
                 f,
@@ -245,9 +262,11 @@ impl fmt::Display for PhysicsError {
             }
             SetupDataMismatch { what } => write!(f, "the stored set-up data does not fit the scene and solver: {what}"),
             UnstableEquilibrium => {
-                f.write_str("every equilibrium found under gravity is unstable (its stiffness has a negative eigenvalue); linearize at rest")
+                f.write_str("every equilibrium found under the loads is unstable (its stiffness has a negative eigenvalue); linearize at rest")
             }
-            NoLoad => f.write_str("modes chosen by the loads, or a static correction, need a load at set-up, and gravity is zero"),
+            NoLoad => f.write_str("modes chosen by the loads, or a static correction, need a load at set-up, and gravity and the point load are zero"),
+            LoadNode { node, held: true } => write!(f, "the point load acts on node {node:?}, which is held in place; choose a free node"),
+            LoadNode { node, held: false } => write!(f, "the point load acts on node {node:?}, which is not in the scene; choose a free node"),
             BasisDeficient { wanted, found } => write!(f, "the basis has {found} independent vectors, {wanted} were asked for"),
             ExplicitTooStiff { stable_step, omega_max, stiffness_per_mass, per_step, max_internal_step, limit, modes } => {
                 let kept = match modes {

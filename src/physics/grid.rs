@@ -44,14 +44,7 @@ impl Grid {
         self.validate()?;
         let (cols, rows, d, h) = (self.columns, self.rows, self.dim, self.spacing);
         let n_nodes = cols * rows;
-        let is_fixed = |node: usize| {
-            let (row, col) = (node / cols, node % cols);
-            row == 0
-                && match self.fixed_nodes {
-                    FixedNodes::TopRow => true,
-                    FixedNodes::TopCorners => col == 0 || col == cols - 1,
-                }
-        };
+        let is_fixed = |node: usize| self.is_held(node);
         // Free nodes first, in node order, then fixed nodes.
         let mut slot_of_node = vec![0; n_nodes];
         let mut next = 0;
@@ -117,6 +110,21 @@ impl Grid {
         let scene = Scene { dim: d, n_nodes, n_free, slot_of_node, rest, dof_mass: vec![self.node_mass; n_free * d], springs };
         scene.check()?;
         Ok(scene)
+    }
+
+    /// The index of node (`row`, `col`), if it is in the grid.
+    pub fn node(&self, row: usize, col: usize) -> Option<usize> {
+        (row < self.rows && col < self.columns).then(|| row * self.columns + col)
+    }
+
+    /// Node `node` is held in place.
+    pub fn is_held(&self, node: usize) -> bool {
+        let (row, col) = (node / self.columns, node % self.columns);
+        row == 0
+            && match self.fixed_nodes {
+                FixedNodes::TopRow => true,
+                FixedNodes::TopCorners => col == 0 || col == self.columns - 1,
+            }
     }
 
     fn validate(&self) -> Result<(), PhysicsError> {

@@ -110,6 +110,8 @@ pub struct Simulator {
     /// Mass of the free nodes and the distance they can travel, for the blow-up bound.
     free_mass: f64,
     reach: f64,
+    /// Shortest spring at rest (the grid spacing) [m], for the anchor's speed limit.
+    spacing: f64,
 }
 
 impl Simulator {
@@ -130,11 +132,16 @@ impl Simulator {
             return Err(PhysicsError::Invalid { quantity: Quantity::Modes, value: 0.0, expected: Expected::AtLeast(1.0) });
         }
         loads.validate(solver.n_modes)?;
+        loads.validate_on(&scene)?;
         let (free_mass, reach) = (scene.free_mass(), scene.reach());
+        let spacing = scene.springs.iter().map(|s| s.rest).filter(|&l| l > 0.0).fold(f64::INFINITY, f64::min);
+        let dim = scene.dim;
         let mut engine = space::build(scene, solver, loads, prebuilt)?;
         engine.apply_loads(loads);
         let mut state = State::at_rest(engine.coordinates());
         engine.rest_coordinates(&mut state.y);
+        // The sheet starts at rest wherever the anchor is.
+        state.anchor[..dim].copy_from_slice(&loads.anchor[..dim]);
         engine.settle(loads, &mut state);
         let mut sim = Simulator {
             outputs: Outputs::new(engine.scene(), solver.n_modes),
@@ -148,6 +155,7 @@ impl Simulator {
             internal_steps_last: 0,
             free_mass,
             reach,
+            spacing,
         };
         sim.check_stable_step_cost()?;
         sim.refresh_outputs();
@@ -196,8 +204,27 @@ impl Simulator {
         }
         let steps = steps as usize;
         let dt = h / steps as f64;
-        let energy_before = self.energy;
+        let mut energy_before = self.energy;
+        // The anchor moves linearly to its target over the step: its
+        // velocity changes by `kick` now, and the free nodes, whose absolute
+        // velocity cannot jump, get -kick relative to it (`docs/method.md`, section 8).
+        let d = self.scene().dim;
+        let (mut rate, mut kick) = ([0.0; 3], [0.0; 3]);
+        for i in 0..d {
+            rate[i] = (self.loads.anchor[i] - self.state.anchor[i]) / h;
+            kick[i] = self.state.anchor_rate[i] - rate[i];
+        }
+        let kick_speed = kick.iter().map(|c| c * c).sum::<f64>().sqrt();
+        if !kick_speed.is_finite() || kick_speed * dt > 0.5 * self.spacing {
+            let cause = StepFailure::AnchorTooFast { speed: kick_speed, limit: 0.5 * self.spacing / dt, dt };
+            return Err(PhysicsError::StepFailed { time: self.state.time, cause });
+        }
         self.backup.copy_from(&self.state);
+        if kick_speed > 0.0 {
+            self.engine.translate_rates(&self.loads, &kick, &mut self.state);
+            // The kick's kinetic energy is supplied, not grown.
+            energy_before += self.free_mass * kick_speed * kick_speed * self.loads.weight_max().powi(2);
+        }
         let mut result = Ok(());
         for _ in 0..steps {
             result = self.engine.step(&self.loads, &mut self.state, dt);
@@ -212,6 +239,8 @@ impl Simulator {
         }
         self.internal_steps_last = steps;
         self.state.time += h;
+        self.state.anchor[..d].copy_from_slice(&self.loads.anchor[..d]);
+        self.state.anchor_rate = rate;
         self.refresh_outputs();
         Ok(())
     }
@@ -224,7 +253,9 @@ impl Simulator {
         }
         let kinetic = self.engine.kinetic_energy(&self.state);
         let g = self.loads.gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
-        let supply = self.free_mass * (g + 1.0) * self.reach * self.loads.weight_max();
+        // The point load does at most |f_p| times the reach on its node (`docs/method.md`, section 8).
+        let point = self.loads.active_point_load(self.scene().dim).map_or(0.0, |f| f.iter().map(|c| c * c).sum::<f64>().sqrt());
+        let supply = (self.free_mass * (g + 1.0) + point) * self.reach * self.loads.weight_max();
         if !(kinetic <= ENERGY_GROWTH_LIMIT * (energy_before + supply)) {
             return Err(StepFailure::EnergyGrowth { kinetic, before: energy_before, dt });
         }
@@ -235,9 +266,17 @@ impl Simulator {
     /// the guard's energy now, the costly ones when asked for.
     fn refresh_outputs(&mut self) {
         self.fresh = Fresh::default();
-        self.outputs.kinetic = self.engine.kinetic_energy(&self.state);
+        let relative = self.engine.kinetic_energy(&self.state);
+        // In the ground's frame: 1/2 (v + c)^T M (v + c), c the anchor's velocity.
+        let c = self.state.anchor_rate;
+        self.outputs.kinetic = if c == [0.0; 3] {
+            relative
+        } else {
+            let p = self.engine.momentum(&self.state);
+            relative + (0..3).map(|i| c[i] * p[i] + 0.5 * self.free_mass * c[i] * c[i]).sum::<f64>()
+        };
         self.engine.modal_coordinates(&self.state, &mut self.outputs.modal_coordinates);
-        self.energy = self.outputs.kinetic + self.engine.model_energy(&self.loads, &self.state).abs();
+        self.energy = relative + self.engine.model_energy(&self.loads, &self.state).abs();
     }
 
     /// The scene being simulated.
@@ -258,6 +297,7 @@ impl Simulator {
     pub fn positions(&mut self) -> &[f64] {
         if !self.fresh.positions {
             self.engine.node_positions(&self.state, &mut self.outputs);
+            shift(&mut self.outputs.positions, &self.state.anchor, self.engine.scene().dim);
             self.fresh.positions = true;
         }
         &self.outputs.positions
@@ -266,9 +306,28 @@ impl Simulator {
     pub fn velocities(&mut self) -> &[f64] {
         if !self.fresh.velocities {
             self.engine.node_velocities(&self.state, &mut self.outputs);
+            shift(&mut self.outputs.velocities, &self.state.anchor_rate, self.engine.scene().dim);
             self.fresh.velocities = true;
         }
         &self.outputs.velocities
+    }
+    /// Position of the load node, `dim` values, if the node is in the
+    /// scene [m]; computed with the node positions.
+    pub fn load_node_position(&mut self) -> Option<&[f64]> {
+        let (node, d) = (self.loads.load_node.filter(|&n| n < self.scene().n_nodes)?, self.scene().dim);
+        Some(&self.positions()[node * d..node * d + d])
+    }
+    /// Velocity of the load node, `dim` values, if the node is in the scene [m/s].
+    pub fn load_node_velocity(&mut self) -> Option<&[f64]> {
+        let (node, d) = (self.loads.load_node.filter(|&n| n < self.scene().n_nodes)?, self.scene().dim);
+        Some(&self.velocities()[node * d..node * d + d])
+    }
+    /// The force the sheet exerts on its held nodes, the sum of the spring
+    /// forces acting on them (`docs/method.md`, section 8); z is 0 in 2D
+    /// [N]. Computed with the node positions.
+    pub fn anchor_force(&mut self) -> [f64; 3] {
+        self.positions();
+        self.outputs.anchor_force
     }
     /// Coordinates of the kept (modal) or reported (full) modes.
     pub fn modal_coordinates(&self) -> &[f64] {
@@ -309,7 +368,11 @@ impl Simulator {
     /// asked after a step.
     pub fn potential_energy(&mut self) -> f64 {
         if !self.fresh.potential {
-            self.outputs.potential = self.engine.potential_energy(&self.loads, &self.state);
+            // The anchor's displacement a moves every free node: -(m g + f_p) . a more.
+            let d = self.scene().dim;
+            let point = self.loads.point_force(self.scene()).map_or([0.0; 3], |(_, f)| std::array::from_fn(|i| f.get(i).copied().unwrap_or(0.0)));
+            let shifted: f64 = (0..d).map(|i| (self.free_mass * self.loads.gravity[i] + point[i]) * self.state.anchor[i]).sum();
+            self.outputs.potential = self.engine.potential_energy(&self.loads, &self.state) - shifted;
             self.fresh.potential = true;
         }
         self.outputs.potential
@@ -341,6 +404,12 @@ impl Simulator {
             return Ok(());
         }
         loads.validate(self.solver.n_modes)?;
+        loads.validate_on(self.scene())?;
+        if loads.same_but_anchor(&self.loads) {
+            // The anchor's target acts from the next step on; nothing moves now.
+            self.loads.anchor = loads.anchor;
+            return Ok(());
+        }
         self.loads.clone_from(loads);
         self.engine.apply_loads(&self.loads);
         self.engine.settle(&self.loads, &mut self.state);
@@ -366,11 +435,24 @@ impl Simulator {
             return Err(PhysicsError::SnapshotNotFinite);
         }
         s.loads.validate(self.solver.n_modes)?;
+        s.loads.validate_on(self.scene())?;
         self.loads.clone_from(&s.loads);
         self.engine.apply_loads(&self.loads);
         self.state.copy_from(&s.state);
         self.engine.evaluate(&self.loads, &self.state);
         self.refresh_outputs();
         Ok(())
+    }
+}
+
+/// Adds the anchor's displacement (or velocity) `a` to every node of
+/// `values` (`d` per node).
+fn shift(values: &mut [f64], a: &[f64; 3], d: usize) {
+    if a[..d].iter().any(|&x| x != 0.0) {
+        for node in values.chunks_exact_mut(d) {
+            for (x, ai) in node.iter_mut().zip(a) {
+                *x += ai;
+            }
+        }
     }
 }

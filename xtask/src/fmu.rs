@@ -77,6 +77,10 @@ pub fn main(args: &[String]) -> Result<(), String> {
             overrides.insert(name.into(), vec![v as f64]);
         }
     }
+    // The load node's column follows the middle of the row (variables.toml, loadColumn).
+    if let (Some(nx), false) = (overrides.get("nx").map(|v| v[0]), overrides.contains_key("loadColumn")) {
+        overrides.insert("loadColumn".into(), vec![(nx / 2.0).floor()]);
+    }
     let check = |name: &str| -> Result<(), String> {
         let var = spec.variable(name).unwrap();
         let x = overrides.get(name).map(|v| v[0]);

@@ -45,7 +45,7 @@ pub struct Full {
 pub struct FullWork {
     alpha: f64,
     beta: f64,
-    /// M g per DOF.
+    /// M g plus the point load, per DOF.
     gravity: Vec<f64>,
     /// Slot positions and elastic energy of the last force evaluation.
     x: Vec<f64>,
@@ -195,9 +195,15 @@ impl Space for Full {
         for (k, g) in w.gravity.iter_mut().enumerate() {
             *g = self.scene.dof_mass[k] * loads.gravity[k % d];
         }
+        // The point load joins M g (`docs/method.md`, section 8).
+        if let Some((dof, f)) = loads.point_force(&self.scene) {
+            for (g, fi) in w.gravity[dof..dof + d].iter_mut().zip(f) {
+                *g += fi;
+            }
+        }
     }
 
-    /// h(u) = f_springs(x* + u) + M g.
+    /// h(u) = f_springs(x* + u) + M g + f_p.
     fn force(&self, _loads: &Loads, u: &[f64], w: &mut FullWork, h: &mut [f64]) {
         for k in 0..u.len() {
             w.x[k] = self.scene.rest[k] + u[k];
@@ -283,16 +289,35 @@ impl Space for Full {
         w.elastic
     }
 
-    /// -(M g)^T u, summed node by node.
+    /// -(M g)^T u, summed node by node, and -f_p^T u at the load node.
     fn gravity_potential(&self, loads: &Loads, u: &[f64], _w: &FullWork) -> f64 {
         let d = self.scene.dim;
         let g = &loads.gravity;
         let work: f64 = u.chunks_exact(d).zip(self.scene.dof_mass.chunks_exact(d)).map(|(u, m)| (0..d).map(|i| m[i] * g[i] * u[i]).sum::<f64>()).sum();
-        -work
+        match loads.point_force(&self.scene) {
+            Some((dof, f)) => -work - f.iter().zip(&u[dof..dof + d]).map(|(f, u)| f * u).sum::<f64>(),
+            None => -work,
+        }
     }
 
     fn kinetic_energy(&self, v: &[f64]) -> f64 {
         0.5 * v.iter().zip(&self.scene.dof_mass).map(|(v, m)| m * v * v).sum::<f64>()
+    }
+
+    /// u' += 1 c on every free node.
+    fn add_translation_rate(&self, _loads: &Loads, c: &[f64; 3], v: &mut [f64]) {
+        let d = self.scene.dim;
+        for (k, vk) in v.iter_mut().enumerate() {
+            *vk += c[k % d];
+        }
+    }
+
+    fn momentum(&self, v: &[f64]) -> [f64; 3] {
+        let (d, mut p) = (self.scene.dim, [0.0; 3]);
+        for (k, (vk, m)) in v.iter().zip(&self.scene.dof_mass).enumerate() {
+            p[k % d] += m * vk;
+        }
+        p
     }
 
     fn dof_velocities(&self, v: &[f64], out: &mut [f64]) {

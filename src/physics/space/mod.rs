@@ -6,12 +6,13 @@
 //!     M y'' + C y' = h(y)
 //! ```
 //!
-//! in its own generalized coordinates y:
+//! in its own generalized coordinates y (f_p: the point load on its node,
+//! `docs/method.md`, section 8):
 //!
 //! | space | y | M | C | h(y) |
 //! |---|---|---|---|---|
-//! | [`Modal`] | modal coordinates q, x = x* + Phi q | I | diag(alpha + beta lambda_i) | w_i (Phi^T (f(x) + M g))_i + (w_i - 1) lambda_i q_i |
-//! | [`Full`] | displacements u of the free DOFs, x = x* + u | lumped masses | alpha M + beta K0 | f(x) + M g |
+//! | [`Modal`] | modal coordinates q, x = x* + Phi q | I | diag(alpha + beta lambda_i) | w_i (Phi^T (f(x) + M g + f_p))_i + (w_i - 1) lambda_i q_i |
+//! | [`Full`] | displacements u of the free DOFs, x = x* + u | lumped masses | alpha M + beta K0 | f(x) + M g + f_p |
 //!
 //! A space value is the constant model of its equations, fixed after
 //! set-up: the scene, the spring incidence, the basis or the sparsity and
@@ -79,7 +80,8 @@ pub trait Space: Send + Sized + 'static {
     /// unless the coordinates are measured from another point than rest).
     fn rest_coordinates(&self, y: &mut [f64]);
 
-    /// Derives the load terms (damping per coordinate, generalized gravity) from `loads`.
+    /// Derives the load terms (damping per coordinate, generalized gravity
+    /// and point load) from `loads`, once per load change.
     fn apply_loads(&self, loads: &Loads, w: &mut Self::Work);
     /// The spring force alone in the space's coordinates (Phi^T f(x) in
     /// the modal space, as its force model evaluates it; f(x) in full space),
@@ -109,7 +111,7 @@ pub trait Space: Send + Sized + 'static {
     fn positions<'w>(&self, y: &[f64], w: &'w mut Self::Work) -> &'w [f64];
     /// Elastic energy of the springs at y, the coordinates of the last [`Space::force`] [J].
     fn elastic_energy(&self, y: &[f64], w: &mut Self::Work) -> f64;
-    /// Potential of gravity relative to the linearization point at y [J].
+    /// Potential of gravity and the point load relative to rest at y [J].
     fn gravity_potential(&self, loads: &Loads, y: &[f64], w: &Self::Work) -> f64;
     /// The potential energy whose gradient the space integrates, at y, the
     /// coordinates of the last [`Space::force`] [J]: elastic energy plus
@@ -121,6 +123,13 @@ pub trait Space: Send + Sized + 'static {
     }
     /// 1/2 v^T M v in physical space [J].
     fn kinetic_energy(&self, v: &[f64]) -> f64;
+    /// Adds to the rates `v` those of a rigid translation of every free
+    /// node with velocity `c` (z is 0 in 2D), each coordinate scaled by its
+    /// weight like a load: the velocity kick of an anchor whose velocity
+    /// changes by -c (`docs/method.md`, section 8).
+    fn add_translation_rate(&self, loads: &Loads, c: &[f64; 3], v: &mut [f64]);
+    /// Momentum of the free nodes per axis, sum_k m_k v_k, at rates `v` [kg m/s].
+    fn momentum(&self, v: &[f64]) -> [f64; 3];
     /// Velocities of the free DOFs.
     fn dof_velocities(&self, v: &[f64], out: &mut [f64]);
     /// Coordinates of the kept or reported modes at y.

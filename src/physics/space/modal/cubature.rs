@@ -545,7 +545,9 @@ fn fit<const D: usize>(chosen: &[(Candidate<D>, Vec<f64>, Vec<f64>)], target: &[
 }
 
 /// Training and held-out poses: every other sample of a short exact run of
-/// the reduced model under the set-up gravity (from the rest state, unit
+/// the reduced model under the set-up gravity and point load, and with
+/// anchor motion ahead ([`ForceSetup::anchor_motion`]) the inertial load of an anchor accelerating at |g| (at least
+/// 1 m/s^2) along +x, +y and +z at once (from the rest state, unit
 /// weights, no damping, explicit Newmark at 0.9 of its stable step, one
 /// period of the slowest kept mode up to 2 s), and around them random poses
 /// q_start + s (q_t - q_start) + delta, s uniform in [0.5, 1.25], delta_j
@@ -558,10 +560,17 @@ fn poses(
     setup: &ForceSetup,
     reduced: &mut dyn FnMut(&[f64], &mut [f64]),
 ) -> Result<(Vec<Vec<f64>>, Vec<Vec<f64>>), PhysicsError> {
-    let (n, r, d) = (modes.basis.n, modes.basis.r, scene.dim);
+    let (n, r) = (modes.basis.n, modes.basis.r);
     let mut gravity = vec![0.0; r];
-    for k in 0..n {
-        let fk = scene.dof_mass[k] * setup.loads.gravity[k % d];
+    let mut load = crate::physics::basis::external_load(scene, setup.loads);
+    if setup.anchor_motion {
+        // An anchor accelerating at |g| (at least 1 m/s^2) along every axis at once adds its inertial load.
+        let accel = setup.loads.gravity[..scene.dim].iter().map(|g| g * g).sum::<f64>().sqrt().max(1.0);
+        for (k, fk) in load.iter_mut().enumerate() {
+            *fk -= scene.dof_mass[k] * accel;
+        }
+    }
+    for (k, fk) in load.into_iter().enumerate() {
         for (j, gj) in gravity.iter_mut().enumerate() {
             *gj += modes.basis.phi[k * r + j] * fk;
         }
@@ -636,12 +645,14 @@ mod tests {
     fn model(name: &str) -> (Scene, Modes, Cubature) {
         let setup = scenes::canonical(name).unwrap();
         let scene = setup.grid.build().unwrap();
-        let options = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest };
+        let options = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest, anchor_motion: false };
         let built = basis::build(&scene, &setup.loads, 6, &options).unwrap();
         let modes = Modes::new(built.modes, built.point, built.at_rest);
         let bound = super::super::taut_reduced_bound(&scene, &modes.basis).unwrap();
         let force = ForceOptions { evaluation: ForceEvaluation::Cubature, cubature_tolerance: 0.002 };
-        let cub = Cubature::new(&scene, &modes, &ForceSetup { loads: &setup.loads, options: &force, omega_sq_bound: bound, prebuilt: None }).unwrap();
+        let cub =
+            Cubature::new(&scene, &modes, &ForceSetup { loads: &setup.loads, options: &force, anchor_motion: false, omega_sq_bound: bound, prebuilt: None })
+                .unwrap();
         (scene, modes, cub)
     }
 

@@ -85,6 +85,8 @@ pub struct ForceSetup<'a> {
     /// The loads at set-up.
     pub loads: &'a Loads,
     pub options: &'a ForceOptions,
+    /// The anchor will move (see [`crate::physics::basis::BasisOptions::anchor_motion`]).
+    pub anchor_motion: bool,
     /// Squared-frequency bound of the reduced system with every spring (1/s^2).
     pub omega_sq_bound: f64,
     /// A stored set of springs and weights to use instead of computing one.
@@ -154,15 +156,18 @@ pub struct Modal<F: ReducedForce = Exact> {
     newton_scale: f64,
     /// 1 / m_k per free DOF.
     inv_mass: Vec<f64>,
+    /// Phi^T M e_i for each axis i (r x 3, row-major): the modal rates of a
+    /// unit rigid translation of the free nodes along axis i.
+    translation: Vec<f64>,
 }
 
 /// Load terms and scratch of a modal run.
 pub struct ModalWork<W> {
     /// c_i = alpha + beta lambda_i.
     damping: Vec<f64>,
-    /// Phi^T M g.
+    /// Phi^T (M g + f_p): gravity and the point load.
     gravity: Vec<f64>,
-    /// -(M g)^T (x* - x_rest): the gravity potential at q = 0.
+    /// -(M g + f_p)^T (x* - x_rest): the potential of the loads at q = 0.
     gravity_offset: f64,
     /// What the force model writes.
     force: W,
@@ -170,7 +175,7 @@ pub struct ModalWork<W> {
     kr: Vec<f64>,
     /// F = Phi^T (f + M g) of the last force evaluation, before the weights (for the error indicator).
     generalized: Vec<f64>,
-    /// ||M g||^2 in the M^-1 norm, the weight's scale of the error indicator.
+    /// ||M g + f_p||^2 in the M^-1 norm, the load's scale of the error indicator.
     load_scale: f64,
     /// Newton matrix, LU-factored in place, with its row permutation.
     jac: Mat<f64>,
@@ -206,11 +211,24 @@ impl<F: ReducedForce> Modal<F> {
         };
         let newton_scale = scene.free_mass().sqrt() * scene.length_scale().max(f64::MIN_POSITIVE);
         let frequencies = modes.basis.frequencies();
-        let setup = ForceSetup { loads, options: force_options, omega_sq_bound: bound, prebuilt: prebuilt.and_then(|d| d.cubature.as_ref()) };
+        let setup = ForceSetup {
+            loads,
+            options: force_options,
+            anchor_motion: options.anchor_motion,
+            omega_sq_bound: bound,
+            prebuilt: prebuilt.and_then(|d| d.cubature.as_ref()),
+        };
         let force = F::new(&scene, &modes, &setup)?;
         let omega_sq_bound = force.taut_bound(&scene, &modes).map_or(bound, |b| b.max(bound));
         let inv_mass = scene.dof_mass.iter().map(|m| 1.0 / m).collect();
-        Ok(Modal { force, frequencies, omega_sq_bound, bound, newton_scale, inv_mass, modes, scene })
+        let (n, r, d) = (modes.basis.n, modes.basis.r, scene.dim);
+        let mut translation = vec![0.0; r * 3];
+        for (j, col) in modes.cols.chunks_exact(n).enumerate() {
+            for (k, (p, m)) in col.iter().zip(&scene.dof_mass).enumerate() {
+                translation[j * 3 + k % d] += p * m;
+            }
+        }
+        Ok(Modal { force, frequencies, omega_sq_bound, bound, newton_scale, inv_mass, translation, modes, scene })
     }
 
     /// The kept modes.
@@ -299,6 +317,19 @@ impl<F: ReducedForce> Space for Modal<F> {
             }
             w.gravity_offset -= fk * (self.modes.point[k] - self.scene.rest[k]);
         }
+        // The point load joins M g: Phi^T f_p, its potential and its share of the load scale
+        // (`docs/method.md`, section 8). Skipped when zero, so runs without it are unchanged.
+        if let Some((dof, f)) = loads.point_force(&self.scene) {
+            for (i, &fi) in f.iter().enumerate() {
+                let k = dof + i;
+                for j in 0..r {
+                    w.gravity[j] += self.modes.basis.phi[k * r + j] * fi;
+                }
+                w.gravity_offset -= fi * (self.modes.point[k] - self.scene.rest[k]);
+                let mg = self.scene.dof_mass[k] * loads.gravity[k % d];
+                w.load_scale += ((mg + fi) * (mg + fi) - mg * mg) * self.inv_mass[k];
+            }
+        }
     }
 
     fn spring_force(&self, q: &[f64], w: &mut Self::Work, out: &mut [f64]) {
@@ -384,7 +415,7 @@ impl<F: ReducedForce> Space for Modal<F> {
         self.force.model_energy(&self.scene, &self.modes, q, &mut w.force) + self.gravity_potential(loads, q, w)
     }
 
-    /// -(M g)^T (x - x_rest) = -(M g)^T (x* - x_rest) - (Phi^T M g)^T q.
+    /// -(M g + f_p)^T (x - x_rest) = -(M g + f_p)^T (x* - x_rest) - (Phi^T (M g + f_p))^T q.
     fn gravity_potential(&self, _loads: &Loads, q: &[f64], w: &Self::Work) -> f64 {
         let modal = -w.gravity.iter().zip(q).map(|(g, q)| g * q).sum::<f64>();
         if self.modes.at_rest {
@@ -410,6 +441,14 @@ impl<F: ReducedForce> Space for Modal<F> {
             total += t * t * inv_mass[k];
             spring += fk * fk * inv_mass[k];
         }
+        if let Some((dof, f)) = loads.point_force(&self.scene) {
+            // The point load is part of the physical force on its node.
+            for (i, &fi) in f.iter().enumerate() {
+                let k = dof + i;
+                let t = springs[k] + mass[k] * loads.gravity[k % d];
+                total += ((t + fi) * (t + fi) - t * t) * inv_mass[k];
+            }
+        }
         let held: f64 = w.generalized.iter().map(|f| f * f).sum();
         let scale = if w.load_scale > 0.0 { w.load_scale } else { spring };
         if scale > 0.0 {
@@ -422,6 +461,25 @@ impl<F: ReducedForce> Space for Modal<F> {
     /// 1/2 |q'|^2, since Phi^T M Phi = I.
     fn kinetic_energy(&self, v: &[f64]) -> f64 {
         0.5 * v.iter().map(|v| v * v).sum::<f64>()
+    }
+
+    /// q' += w_i Phi^T M (1 c): a rigid velocity c of the free nodes,
+    /// projected and weighted like every load.
+    fn add_translation_rate(&self, loads: &Loads, c: &[f64; 3], v: &mut [f64]) {
+        for (j, (vj, t)) in v.iter_mut().zip(self.translation.chunks_exact(3)).enumerate() {
+            *vj += loads.mode_weights[j] * (t[0] * c[0] + t[1] * c[1] + t[2] * c[2]);
+        }
+    }
+
+    /// sum_k m_k e_k (Phi q')_k = sum_j (Phi^T M e)_j q'_j per axis.
+    fn momentum(&self, v: &[f64]) -> [f64; 3] {
+        let mut p = [0.0; 3];
+        for (vj, t) in v.iter().zip(self.translation.chunks_exact(3)) {
+            for i in 0..3 {
+                p[i] += t[i] * vj;
+            }
+        }
+        p
     }
 
     /// Phi q'.
