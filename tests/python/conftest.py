@@ -4,6 +4,11 @@ The FMUs are found in ``$MMS_FMU_DIR`` if set, else in ``$CARGO_TARGET_DIR/fmu``
 or ``<repo>/target/fmu``. ``cargo xtask test`` builds them before running
 pytest; when one is missing here it is built with ``cargo xtask fmu``.
 
+The reference importer fmusim is ``$MMS_FMUSIM`` if set, else
+``<target>/tools/fmusim`` (``cargo xtask fmusim`` builds it, ``cargo xtask
+test`` does so before pytest). Without it its tests are skipped, except on CI
+(``CI=true``), where they fail.
+
 The canonical scenes are read from ``modelDescription/variables.toml`` (the
 single source of the variables and scenes), so a new scene gets tested
 without touching this file.
@@ -33,13 +38,31 @@ def scene_names():
 SCENES = scene_names()
 
 
+def target_dir() -> Path:
+    target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
+    return target if target.is_absolute() else ROOT / target
+
+
 def fmu_dir() -> Path:
     if os.environ.get("MMS_FMU_DIR"):
         return Path(os.environ["MMS_FMU_DIR"])
-    target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
-    if not target.is_absolute():
-        target = ROOT / target
-    return target / "fmu"
+    return target_dir() / "fmu"
+
+
+def on_ci() -> bool:
+    return os.environ.get("CI", "").lower() in ("true", "1")
+
+
+@pytest.fixture(scope="session")
+def fmusim() -> str:
+    """Path of the fmusim binary; skips the test when it is missing, fails it on CI."""
+    path = Path(os.environ.get("MMS_FMUSIM") or target_dir() / "tools" / "fmusim")
+    if not (path.is_file() and os.access(path, os.X_OK)):
+        reason = f"fmusim not found at {path}: build it with `cargo xtask setup && cargo xtask fmusim`"
+        if on_ci():
+            pytest.fail(f"{reason} (CI=true: the fmusim tests must run)")
+        pytest.skip(reason)
+    return str(path)
 
 
 def fmu_path(scene=None) -> Path:

@@ -5,6 +5,7 @@
 //! - `test`   every test: Rust (cargo test) and Python (pytest + fmpy)
 //! - `report` the error-against-run-time study into `report/` (`--quick`: small, for CI)
 //! - `setup`  install what the other tasks need (libclang, valgrind, Python venv with fmpy)
+//! - `fmusim` build the reference FMI importer fmusim into `target/tools/fmusim`
 //! - `fuzz`   the cargo-fuzz targets for a bounded time (`--seconds N`)
 //! - `valgrind` leak check of instantiate/step/serialize/free cycles
 //! - `stability` the stability matrix, its table written into docs/stability.md
@@ -15,6 +16,7 @@ mod generate;
 
 mod docs;
 mod fmu;
+mod fmusim;
 mod fuzz;
 mod report;
 mod run;
@@ -36,12 +38,13 @@ fn main() -> ExitCode {
         "test" => run::test(rest),
         "report" => report::main(rest),
         "setup" => setup::main(rest),
+        "fmusim" => fmusim::main(rest),
         "fuzz" => fuzz::main(rest),
         "valgrind" => valgrind::main(rest),
         "stability" => stability::main(rest),
         "docs" => docs::main(rest),
         _ => {
-            eprintln!("usage: cargo xtask <fmu|run|test|report|setup|fuzz|valgrind|stability|docs> [options]");
+            eprintln!("usage: cargo xtask <fmu|run|test|report|setup|fmusim|fuzz|valgrind|stability|docs> [options]");
             return ExitCode::from(2);
         }
     };

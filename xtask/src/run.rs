@@ -7,7 +7,8 @@
 //!   per canonical scene into `target/fmu/`, run `cargo test --release --workspace`
 //!   (with the XSD validation of the model description and the soak run of a
 //!   million steps), each fuzz target for FUZZ_SECONDS, the quick study,
-//!   pytest on `tests/python` with the venv's Python and the valgrind leak check.
+//!   the reference importer fmusim (`target/tools/fmusim`), pytest on
+//!   `tests/python` with the venv's Python and the valgrind leak check.
 //!   Every stage always runs; the task fails if any fails.
 
 use std::path::{Path, PathBuf};
@@ -15,7 +16,7 @@ use std::process::Command;
 use std::time::Instant;
 
 use crate::setup::{cargo, target_dir};
-use crate::{fmu, fuzz, setup, valgrind};
+use crate::{fmu, fmusim, fuzz, setup, valgrind};
 
 /// Packages and features of every cargo build of the test stage: the same
 /// for the tests, the quick study and the valgrind example, so each builds
@@ -169,8 +170,24 @@ pub fn test(args: &[String]) -> Result<(), String> {
     }
     lap("report --quick", &mut times);
 
+    // tests/python/test_fmusim.py runs the FMU in the reference importer;
+    // on CI a missing binary fails those tests.
+    step("cargo xtask fmusim");
+    let fmusim = match fmusim::build(&root, false) {
+        Ok(path) => Some(path),
+        Err(e) => {
+            failures.push(format!("fmusim: {e}"));
+            None
+        }
+    };
+    lap("fmusim", &mut times);
+
     step("pytest tests/python");
-    let status = Command::new(setup::python())
+    let mut pytest = Command::new(setup::python());
+    if let Some(path) = &fmusim {
+        pytest.env("MMS_FMUSIM", path);
+    }
+    let status = pytest
         .current_dir(&root)
         .env("MMS_FMU_DIR", fmu_dir(&root))
         .env("MMS_REPORT_DIR", &report_dir)
@@ -199,7 +216,7 @@ pub fn test(args: &[String]) -> Result<(), String> {
     eprintln!("\ntimes: {}", summary.join(", "));
 
     if failures.is_empty() {
-        eprintln!("\nall tests passed (cargo test, pytest, valgrind, fuzzing)");
+        eprintln!("\nall tests passed (cargo test, pytest with fmpy and fmusim, valgrind, fuzzing)");
         Ok(())
     } else {
         Err(format!("failed: {}", failures.join("; ")))

@@ -4,8 +4,10 @@
 //! - Debian packages, through apt-get (`apt-get update` once, only when
 //!   something has to be installed): `libclang-dev` (bindgen in `fmi-sys`)
 //!   to build the FMU; for the tests also `libxml2-dev` (XSD validation in
-//!   `fmi-rs`), `valgrind` (`cargo xtask valgrind`) and `libclang-rt-dev`
-//!   (the libFuzzer runtime `cargo xtask fuzz` links).
+//!   `fmi-rs`), `valgrind` (`cargo xtask valgrind`), `libclang-rt-dev`
+//!   (the libFuzzer runtime `cargo xtask fuzz` links) and what the reference
+//!   importer fmusim is built with (`cargo xtask fmusim`): `gcc`,
+//!   `libsundials-dev`, `libminizip-dev`, `zlib1g-dev` and `libxml2-dev`.
 //! - The Python environment `.venv` in the repository root: fmpy, numpy and
 //!   matplotlib to run the main job; pytest for the tests.
 
@@ -22,7 +24,17 @@ pub enum Purpose {
 }
 
 /// Debian packages: (package, needed for the tests only).
-const DEBIAN_PACKAGES: &[(&str, bool)] = &[("libclang-dev", false), ("libxml2-dev", true), ("valgrind", true), ("libclang-rt-dev", true)];
+const DEBIAN_PACKAGES: &[(&str, bool)] = &[
+    ("libclang-dev", false),
+    ("libxml2-dev", true),
+    ("valgrind", true),
+    ("libclang-rt-dev", true),
+    // fmusim (xtask/src/fmusim.rs); libxml2-dev above too
+    ("gcc", true),
+    ("libsundials-dev", true),
+    ("libminizip-dev", true),
+    ("zlib1g-dev", true),
+];
 
 /// Python packages: (distribution name as pip knows it, requirement to install, needed for the tests only).
 const PYTHON_PACKAGES: &[(&str, &str, bool)] =
