@@ -4,6 +4,7 @@
 //! - `run`    build the FMU and run the main job through fmpy (summary + plot)
 //! - `test`   every test: Rust (cargo test) and Python (pytest + fmpy)
 //! - `report` the error-against-run-time study into `report/` (`--quick`: small, for CI)
+//! - `sweep`  a parameter sweep of FMU runs on Dask (python/sweep.py): CSV and plot in `out/sweep/`
 //! - `setup`  install what the other tasks need (libclang, valgrind, Python venv with fmpy)
 //! - `fmusim` build the reference FMI importer fmusim into `target/tools/fmusim`
 //! - `fuzz`   the cargo-fuzz targets for a bounded time (`--seconds N`)
@@ -22,6 +23,7 @@ mod report;
 mod run;
 mod setup;
 mod stability;
+mod sweep;
 mod valgrind;
 
 use std::process::ExitCode;
@@ -42,9 +44,10 @@ fn main() -> ExitCode {
         "fuzz" => fuzz::main(rest),
         "valgrind" => valgrind::main(rest),
         "stability" => stability::main(rest),
+        "sweep" => sweep::main(rest),
         "docs" => docs::main(rest),
         _ => {
-            eprintln!("usage: cargo xtask <fmu|run|test|report|setup|fmusim|fuzz|valgrind|stability|docs> [options]");
+            eprintln!("usage: cargo xtask <fmu|run|test|report|sweep|setup|fmusim|fuzz|valgrind|stability|docs> [options]");
             return ExitCode::from(2);
         }
     };

@@ -1,5 +1,5 @@
-//! `cargo xtask setup [--for run|test]`: installs what a task needs, and
-//! only what is missing, so it is cheap to run again.
+//! `cargo xtask setup [--for run|sweep|test]`: installs what a task needs,
+//! and only what is missing, so it is cheap to run again.
 //!
 //! - Debian packages, through apt-get (`apt-get update` once, only when
 //!   something has to be installed): `libclang-dev` (bindgen in `fmi-sys`)
@@ -9,39 +9,48 @@
 //!   importer fmusim is built with (`cargo xtask fmusim`): `gcc`,
 //!   `libsundials-dev`, `libminizip-dev`, `zlib1g-dev` and `libxml2-dev`.
 //! - The Python environment `.venv` in the repository root: fmpy, numpy and
-//!   matplotlib to run the main job; pytest for the tests.
+//!   matplotlib to run the main job; dask.distributed for parameter sweeps
+//!   (`cargo xtask sweep`, python/sweep.py); pytest for the tests.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-/// What the installation is for.
-#[derive(Clone, Copy, PartialEq, Eq)]
+/// What the installation is for; each purpose needs what the ones before it need.
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Purpose {
     /// Build the FMU and run the main job (`cargo xtask run`, `cargo xtask fmu`).
     Run,
+    /// Also parameter sweeps on Dask (`cargo xtask sweep`).
+    Sweep,
     /// Everything `cargo xtask test` runs: also fuzzing, valgrind, the XSD check and pytest.
     Test,
 }
 
-/// Debian packages: (package, needed for the tests only).
-const DEBIAN_PACKAGES: &[(&str, bool)] = &[
-    ("libclang-dev", false),
-    ("libxml2-dev", true),
-    ("valgrind", true),
-    ("libclang-rt-dev", true),
+/// Debian packages: (package, the first purpose that needs it).
+const DEBIAN_PACKAGES: &[(&str, Purpose)] = &[
+    ("libclang-dev", Purpose::Run),
+    ("libxml2-dev", Purpose::Test),
+    ("valgrind", Purpose::Test),
+    ("libclang-rt-dev", Purpose::Test),
     // fmusim (xtask/src/fmusim.rs); libxml2-dev above too
-    ("gcc", true),
-    ("libsundials-dev", true),
-    ("libminizip-dev", true),
-    ("zlib1g-dev", true),
+    ("gcc", Purpose::Test),
+    ("libsundials-dev", Purpose::Test),
+    ("libminizip-dev", Purpose::Test),
+    ("zlib1g-dev", Purpose::Test),
 ];
 
-/// Python packages: (distribution name as pip knows it, requirement to install, needed for the tests only).
-const PYTHON_PACKAGES: &[(&str, &str, bool)] =
-    &[("fmpy", "fmpy==0.3.32", false), ("numpy", "numpy", false), ("matplotlib", "matplotlib", false), ("pytest", "pytest", true)];
-
-/// The version of fmpy the tests are written against.
-const FMPY_VERSION: &str = "0.3.32";
+/// Python packages: (distribution name as pip knows it, requirement to
+/// install, the first purpose that needs it). A requirement `NAME==V` is also
+/// installed over another version. fmpy is the version the tests are written
+/// against; dask and distributed are released together, so one pin holds both
+/// (`distributed` is checked: it comes only with the extra).
+const PYTHON_PACKAGES: &[(&str, &str, Purpose)] = &[
+    ("fmpy", "fmpy==0.3.32", Purpose::Run),
+    ("numpy", "numpy", Purpose::Run),
+    ("matplotlib", "matplotlib", Purpose::Run),
+    ("distributed", "dask[distributed]==2026.8.0", Purpose::Sweep),
+    ("pytest", "pytest", Purpose::Test),
+];
 
 pub fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
@@ -71,8 +80,9 @@ pub fn main(args: &[String]) -> Result<(), String> {
     let purpose = match args {
         [] => Purpose::Test,
         [f, p] if f == "--for" && p == "run" => Purpose::Run,
+        [f, p] if f == "--for" && p == "sweep" => Purpose::Sweep,
         [f, p] if f == "--for" && p == "test" => Purpose::Test,
-        _ => return Err("usage: cargo xtask setup [--for run|test] (default: test, everything)".into()),
+        _ => return Err("usage: cargo xtask setup [--for run|sweep|test] (default: test, everything)".into()),
     };
     install(purpose)
 }
@@ -85,8 +95,8 @@ pub fn install(purpose: Purpose) -> Result<(), String> {
     Ok(())
 }
 
-fn wanted<T: Copy>(list: &[(T, bool)], purpose: Purpose) -> Vec<T> {
-    list.iter().filter(|(_, test_only)| purpose == Purpose::Test || !test_only).map(|(x, _)| *x).collect()
+fn wanted<T: Copy>(list: &[(T, Purpose)], purpose: Purpose) -> Vec<T> {
+    list.iter().filter(|(_, needed_from)| purpose >= *needed_from).map(|(x, _)| *x).collect()
 }
 
 fn debian_installed(pkg: &str) -> bool {
@@ -181,12 +191,13 @@ fn installed_version(dist: &str) -> Option<String> {
 
 fn python_packages(purpose: Purpose) -> Result<(), String> {
     let mut missing = Vec::new();
-    for (dist, req, test_only) in PYTHON_PACKAGES {
-        if *test_only && purpose == Purpose::Run {
+    for (dist, req, needed_from) in PYTHON_PACKAGES {
+        if purpose < *needed_from {
             continue;
         }
+        let pinned = req.split_once("==").map(|(_, v)| v);
         match installed_version(dist) {
-            Some(v) if *dist != "fmpy" || v == FMPY_VERSION => {}
+            Some(v) if pinned.is_none_or(|p| v == p) => {}
             _ => missing.push(*req),
         }
     }

@@ -1,0 +1,165 @@
+"""Parameter sweeps (python/sweep.py): a sweep on a LocalCluster of two worker
+processes on the loopback interface gives the serial sweep's numbers bit for
+bit; refused configurations are rows with their error; the command line
+writes the CSV and the plot, also through --scheduler."""
+
+import csv
+import math
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from fmpy import read_model_description
+
+from conftest import ROOT
+
+sys.path.insert(0, str(ROOT / "python"))
+import sweep  # noqa: E402
+
+distributed = pytest.importorskip("distributed", reason="dask.distributed is installed by cargo xtask setup")
+
+STOP = 0.3
+# 6 runs: two stiffnesses and an out-of-range one, two numbers of modes.
+GRID = ["springStiffness=50,200,-1", "nModes=2,4"]
+
+
+def deterministic(rows):
+    """The rows without the columns that may differ between executions;
+    floats as their exact repr, so that NaN equals NaN and nothing is rounded."""
+    return [{k: sweep.cell(v) for k, v in r.items() if k not in sweep.NONDETERMINISTIC} for r in rows]
+
+
+@pytest.fixture(scope="module")
+def md(default_fmu):
+    return read_model_description(default_fmu)
+
+
+@pytest.fixture(scope="module")
+def client():
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None)
+    c = distributed.Client(cluster)
+    c.wait_for_workers(2)
+    yield c
+    c.close()
+    cluster.close()
+
+
+@pytest.fixture(scope="module")
+def sweeps(default_fmu, md, client):
+    """The same sweep serially and on the cluster, with their wall times."""
+    axes = sweep.parse_grid(md, GRID)
+    t0 = time.perf_counter()
+    serial = sweep.run_sweep(default_fmu, axes, stop_time=STOP, progress=False)
+    t1 = time.perf_counter()
+    on_cluster = sweep.run_sweep(default_fmu, axes, stop_time=STOP, client=client, progress=False)
+    t2 = time.perf_counter()
+    print(f"\nsweep of {len(serial)} runs: serial {t1 - t0:.2f} s, 2 workers {t2 - t1:.2f} s")
+    return axes, serial, on_cluster
+
+
+def test_grid_from_the_command_line(md):
+    axes = sweep.parse_grid(md, ["springStiffness=100,200", "nModes=4,8", "modeSelection=load,1", "staticCorrection=true,false", "step=0.01", "gravity=0 -9.81 0,2 -9.81 0"])
+    assert axes == [
+        ("springStiffness", [100.0, 200.0]),
+        ("nModes", [4, 8]),
+        ("modeSelection", ["load", "lowest"]),
+        ("staticCorrection", [True, False]),
+        ("step", [0.01]),
+        ("gravity", [[0.0, -9.81, 0.0], [2.0, -9.81, 0.0]]),
+    ]
+    points = sweep.grid_points(axes)
+    assert len(points) == 2 * 2 * 2 * 2 * 2
+    assert points[0]["springStiffness"] == 100.0 and points[-1]["gravity"] == [2.0, -9.81, 0.0]
+    assert len({tuple(map(str, p.values())) for p in points}) == len(points)
+    for bad in (["positions=1"], ["noSuchParameter=1"], ["modeSelection=nearest"], ["staticCorrection=maybe"], ["step=0"], ["nModes"], ["nModes=2", "nModes=4"]):
+        with pytest.raises(ValueError):
+            sweep.parse_grid(md, bad)
+
+
+def test_cluster_gives_the_serial_numbers(sweeps):
+    axes, serial, on_cluster = sweeps
+    assert len(serial) == len(on_cluster) == 6
+    assert deterministic(on_cluster) == deterministic(serial)
+    # the runs did go to the two worker processes, not to this one
+    workers = {r["worker"] for r in on_cluster}
+    assert len(workers) == 2, workers
+    assert not any(w.endswith(f":{os.getpid()}") for w in workers)
+    assert all(r["wallTime"] > 0 for r in serial + on_cluster)
+
+
+def test_each_run_has_its_own_parameters(sweeps):
+    _, serial, _ = sweeps
+    ok = {(r["springStiffness"], r["nModes"]): r for r in serial if r["status"] == "ok"}
+    assert sorted(ok) == [(50.0, 2), (50.0, 4), (200.0, 2), (200.0, 4)]
+    for r in ok.values():
+        assert r["finalTime"] == pytest.approx(STOP) and r["outputPoints"] == 30
+        assert r["maxSag"] > 0 and r["maxKineticEnergy"] > 0 and r["finalPotentialEnergy"] < 0
+    # the modes of K phi = lambda M phi: four times the stiffness, twice the frequency
+    for m in (2, 4):
+        assert ok[200.0, m]["lowestFrequency"] / ok[50.0, m]["lowestFrequency"] == pytest.approx(2.0, rel=1e-9)
+    # a stiffer sheet swings less; more modes, another trajectory
+    assert ok[200.0, 2]["maxSag"] < ok[50.0, 2]["maxSag"]
+    assert ok[50.0, 4]["finalSag"] != ok[50.0, 2]["finalSag"]
+
+
+def test_refused_configurations_are_rows(sweeps, default_fmu, md, client):
+    _, serial, on_cluster = sweeps
+    for rows in (serial, on_cluster):
+        refused = [r for r in rows if r["springStiffness"] == -1.0]
+        assert len(refused) == 2
+        for r in refused:
+            assert r["status"] == "error"
+            assert "springStiffness" in r["message"] and "refused" in r["message"]
+            assert math.isnan(r["finalSag"]) and r["outputPoints"] == 0
+    # set-up refuses more modes than the scene has degrees of freedom (180), on a
+    # worker too; the run beside it is not disturbed
+    rows = sweep.run_sweep(default_fmu, sweep.parse_grid(md, ["nModes=500,2"]), stop_time=0.1, client=client, progress=False)
+    assert [r["status"] for r in rows] == ["error", "ok"]
+    assert "nModes = 500" in rows[0]["message"], rows[0]["message"]
+    assert rows[1]["outputPoints"] == 10 and np.isfinite(rows[1]["finalSag"])
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        return [{k: v for k, v in r.items() if k not in sweep.NONDETERMINISTIC} for r in csv.DictReader(f)]
+
+
+def test_command_line_serial_and_scheduler(sweeps, default_fmu, client, tmp_path):
+    axes, serial, _ = sweeps
+    expected = tmp_path / "expected.csv"
+    sweep.write_csv(expected, serial, sweep.columns(axes))
+    args = [str(default_fmu), "--stop-time", str(STOP), "--quiet"] + [a for g in GRID for a in ("--param", g)]
+    outputs = {}
+    for mode in (["--serial"], ["--scheduler", client.scheduler.address]):
+        out = tmp_path / mode[0].lstrip("-") / "sweep.csv"
+        run = subprocess.run([sys.executable, str(ROOT / "python" / "sweep.py"), *args, *mode, "--out", str(out)], capture_output=True, text=True, timeout=120)
+        assert run.returncode == 0, run.stderr
+        assert "6 runs" in run.stdout and "2 error, 4 ok" in run.stdout, run.stdout
+        assert out.with_suffix(".png").stat().st_size > 10_000
+        try:
+            import pyarrow  # noqa: F401
+
+            assert out.with_suffix(".parquet").exists()
+        except ImportError:
+            assert not out.with_suffix(".parquet").exists()
+        outputs[mode[0]] = read_csv(out)
+    assert outputs["--serial"] == read_csv(expected)
+    assert outputs["--scheduler"] == read_csv(expected)
+    assert list(outputs["--serial"][0]) == ["run", "springStiffness", "nModes"] + sweep.METRICS
+
+
+def test_documented_sweeps_parse(md):
+    """The sweep commands of the README and docs/usage.md name real parameters and values."""
+    import shlex
+
+    lines = [l.strip().strip("`") for doc in ("README.md", "docs/usage.md") for l in (ROOT / doc).read_text().splitlines()]
+    commands = [l for l in lines if l.startswith(("cargo xtask sweep --", ".venv/bin/python python/sweep.py"))]
+    assert len(commands) >= 4, commands
+    for command in commands:
+        args = shlex.split(command)
+        params = [args[i + 1] for i, a in enumerate(args) if a == "--param"]
+        assert params, command
+        assert sweep.parse_grid(md, params)
