@@ -236,8 +236,8 @@ pub fn computed(sim: &mut Simulator, vr: u32, time0: f64) -> Computed<'_> {
     }
 }
 
-/// Component `i` of a node vector: 0 past the scene's dimension (z in 2D),
-/// NaN when there is no such node (set-up refuses a load node outside the grid).
-fn component(v: Option<&[f64]>, i: usize) -> f64 {
-    v.map_or(f64::NAN, |v| v.get(i).copied().unwrap_or(0.0))
+/// Component `i` of a node vector (z is 0 in 2D); NaN when there is no
+/// such node (set-up refuses a load node outside the grid).
+fn component(v: Option<[f64; 3]>, i: usize) -> f64 {
+    v.map_or(f64::NAN, |v| v[i])
 }

@@ -64,6 +64,14 @@ pub trait Stepper: Send {
     fn node_positions(&mut self, state: &State, out: &mut Outputs);
     /// Node velocities of `state` into `out.velocities` (held nodes stay at 0).
     fn node_velocities(&mut self, state: &State, out: &mut Outputs);
+    /// Position of one node of `state` (whose forces were evaluated last),
+    /// without the others; z is 0 in 2D.
+    fn node_position(&mut self, state: &State, node: usize) -> [f64; 3];
+    /// Velocity of one node of `state` (0 for a held node); z is 0 in 2D.
+    fn node_velocity(&self, state: &State, node: usize) -> [f64; 3];
+    /// The anchor force of `state` from the springs that touch a held node
+    /// alone, without the other positions.
+    fn anchor_force(&mut self, state: &State) -> [f64; 3];
     /// Elastic energy of every spring plus gravity potential at `state` [J].
     fn potential_energy(&mut self, loads: &Loads, state: &State) -> f64;
     /// The force the space cannot represent at `state`, relative to the load.
@@ -263,6 +271,37 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
             2 => to_node_order::<2>(&scene.slot_of_node, scene.n_free, &out.dof_velocities, &mut out.velocities),
             _ => to_node_order::<3>(&scene.slot_of_node, scene.n_free, &out.dof_velocities, &mut out.velocities),
         }
+    }
+
+    fn node_position(&mut self, state: &State, node: usize) -> [f64; 3] {
+        self.space.slot_position(&state.y, self.space.scene().slot_of_node[node], &mut self.work)
+    }
+
+    fn node_velocity(&self, state: &State, node: usize) -> [f64; 3] {
+        let scene = self.space.scene();
+        let slot = scene.slot_of_node[node];
+        if slot < scene.n_free {
+            self.space.slot_velocity(&state.v, slot)
+        } else {
+            [0.0; 3]
+        }
+    }
+
+    fn anchor_force(&mut self, state: &State) -> [f64; 3] {
+        let d = self.space.scene().dim;
+        let mut f = [0.0; 3];
+        for &(held, other, k, rest) in &self.anchors {
+            let (xh, xo) = (self.space.slot_position(&state.y, held, &mut self.work), self.space.slot_position(&state.y, other, &mut self.work));
+            let diff: [f64; 3] = std::array::from_fn(|i| xo[i] - xh[i]);
+            let l = diff[..d].iter().map(|c| c * c).sum::<f64>().sqrt();
+            if l > 0.0 {
+                let t = k * (l - rest) / l;
+                for i in 0..d {
+                    f[i] += t * diff[i];
+                }
+            }
+        }
+        f
     }
 
     fn potential_energy(&mut self, loads: &Loads, state: &State) -> f64 {

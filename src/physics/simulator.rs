@@ -87,6 +87,8 @@ pub fn internal_step_count(h: f64, dt_max: f64) -> f64 {
 #[derive(Clone, Copy, Debug, Default)]
 struct Fresh {
     positions: bool,
+    /// The anchor force (also computed with the positions).
+    anchor: bool,
     velocities: bool,
     potential: bool,
     residual: bool,
@@ -311,22 +313,35 @@ impl Simulator {
         }
         &self.outputs.velocities
     }
-    /// Position of the load node, `dim` values, if the node is in the
-    /// scene [m]; computed with the node positions.
-    pub fn load_node_position(&mut self) -> Option<&[f64]> {
+    /// Position of the load node (z 0 in 2D), if the node is in the scene
+    /// [m]: read from the node positions when they are computed, else
+    /// computed for this node alone.
+    pub fn load_node_position(&mut self) -> Option<[f64; 3]> {
         let (node, d) = (self.loads.load_node.filter(|&n| n < self.scene().n_nodes)?, self.scene().dim);
-        Some(&self.positions()[node * d..node * d + d])
+        if self.fresh.positions {
+            return Some(std::array::from_fn(|i| if i < d { self.outputs.positions[node * d + i] } else { 0.0 }));
+        }
+        let x = self.engine.node_position(&self.state, node);
+        Some(std::array::from_fn(|i| if i < d { x[i] + self.state.anchor[i] } else { 0.0 }))
     }
-    /// Velocity of the load node, `dim` values, if the node is in the scene [m/s].
-    pub fn load_node_velocity(&mut self) -> Option<&[f64]> {
+    /// Velocity of the load node (z 0 in 2D), if the node is in the scene [m/s].
+    pub fn load_node_velocity(&mut self) -> Option<[f64; 3]> {
         let (node, d) = (self.loads.load_node.filter(|&n| n < self.scene().n_nodes)?, self.scene().dim);
-        Some(&self.velocities()[node * d..node * d + d])
+        if self.fresh.velocities {
+            return Some(std::array::from_fn(|i| if i < d { self.outputs.velocities[node * d + i] } else { 0.0 }));
+        }
+        let v = self.engine.node_velocity(&self.state, node);
+        Some(std::array::from_fn(|i| if i < d { v[i] + self.state.anchor_rate[i] } else { 0.0 }))
     }
     /// The force the sheet exerts on its held nodes, the sum of the spring
     /// forces acting on them (`docs/method.md`, section 8); z is 0 in 2D
-    /// [N]. Computed with the node positions.
+    /// [N]. Computed with the node positions, or alone from the springs that
+    /// touch a held node when the positions are not asked for.
     pub fn anchor_force(&mut self) -> [f64; 3] {
-        self.positions();
+        if !self.fresh.positions && !self.fresh.anchor {
+            self.outputs.anchor_force = self.engine.anchor_force(&self.state);
+            self.fresh.anchor = true;
+        }
         self.outputs.anchor_force
     }
     /// Coordinates of the kept (modal) or reported (full) modes.

@@ -312,6 +312,11 @@ impl Space for Full {
         }
     }
 
+    fn slot_velocity(&self, v: &[f64], slot: usize) -> [f64; 3] {
+        let d = self.scene.dim;
+        std::array::from_fn(|i| if i < d { v[slot * d + i] } else { 0.0 })
+    }
+
     fn momentum(&self, v: &[f64]) -> [f64; 3] {
         let (d, mut p) = (self.scene.dim, [0.0; 3]);
         for (k, (vk, m)) in v.iter().zip(&self.scene.dof_mass).enumerate() {

@@ -109,6 +109,17 @@ pub trait Space: Send + Sized + 'static {
 
     /// Slot positions at y, the coordinates of the last [`Space::force`].
     fn positions<'w>(&self, y: &[f64], w: &'w mut Self::Work) -> &'w [f64];
+    /// Position of one slot at y, the coordinates of the last
+    /// [`Space::force`] (`dim` values, z 0 in 2D): the same bits as
+    /// [`Space::positions`] holds for it, at the cost of one slot.
+    fn slot_position(&self, y: &[f64], slot: usize, w: &mut Self::Work) -> [f64; 3] {
+        let d = self.scene().dim;
+        let x = self.positions(y, w);
+        std::array::from_fn(|i| if i < d { x[slot * d + i] } else { 0.0 })
+    }
+    /// Velocity of one free slot at rates v (z 0 in 2D): the same bits as
+    /// [`Space::dof_velocities`] gives for it.
+    fn slot_velocity(&self, v: &[f64], slot: usize) -> [f64; 3];
     /// Elastic energy of the springs at y, the coordinates of the last [`Space::force`] [J].
     fn elastic_energy(&self, y: &[f64], w: &mut Self::Work) -> f64;
     /// Potential of gravity and the point load relative to rest at y [J].

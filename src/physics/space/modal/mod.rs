@@ -471,6 +471,36 @@ impl<F: ReducedForce> Space for Modal<F> {
         }
     }
 
+    /// x* + Phi q at one slot, summed mode by mode as [`Modes::expand`] does
+    /// (the same bits), without expanding the others; held slots stay at x*.
+    fn slot_position(&self, q: &[f64], slot: usize, _w: &mut Self::Work) -> [f64; 3] {
+        let (n, d) = (self.modes.basis.n, self.scene.dim);
+        let mut x = [0.0; 3];
+        for i in 0..d {
+            let k = slot * d + i;
+            x[i] = self.modes.point[k];
+            if k < n {
+                for (col, qj) in self.modes.cols.chunks_exact(n).zip(q) {
+                    x[i] += col[k] * qj;
+                }
+            }
+        }
+        x
+    }
+
+    /// Phi q' at one free slot, summed as [`Modes::expand_rates`] does.
+    fn slot_velocity(&self, v: &[f64], slot: usize) -> [f64; 3] {
+        let (n, d) = (self.modes.basis.n, self.scene.dim);
+        let mut out = [0.0; 3];
+        for (i, o) in out.iter_mut().enumerate().take(d) {
+            let k = slot * d + i;
+            for (col, vj) in self.modes.cols.chunks_exact(n).zip(v) {
+                *o += col[k] * vj;
+            }
+        }
+        out
+    }
+
     /// sum_k m_k e_k (Phi q')_k = sum_j (Phi^T M e)_j q'_j per axis.
     fn momentum(&self, v: &[f64]) -> [f64; 3] {
         let mut p = [0.0; 3];
