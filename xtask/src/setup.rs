@@ -7,7 +7,9 @@
 //!   `fmi-rs`), `valgrind` (`cargo xtask valgrind`) and `libclang-rt-dev`
 //!   (the libFuzzer runtime `cargo xtask fuzz` links).
 //! - The Python environment `.venv` in the repository root: fmpy, numpy and
-//!   matplotlib to run the main job; pytest for the tests.
+//!   matplotlib to run the main job; for the tests pytest and
+//!   fmu-manipulation-toolbox (its `fmucontainer` is one of the co-simulation
+//!   masters `tests/python/test_chain.py` runs the FMU under).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -24,12 +26,16 @@ pub enum Purpose {
 /// Debian packages: (package, needed for the tests only).
 const DEBIAN_PACKAGES: &[(&str, bool)] = &[("libclang-dev", false), ("libxml2-dev", true), ("valgrind", true), ("libclang-rt-dev", true)];
 
-/// Python packages: (distribution name as pip knows it, requirement to install, needed for the tests only).
-const PYTHON_PACKAGES: &[(&str, &str, bool)] =
-    &[("fmpy", "fmpy==0.3.32", false), ("numpy", "numpy", false), ("matplotlib", "matplotlib", false), ("pytest", "pytest", true)];
-
-/// The version of fmpy the tests are written against.
-const FMPY_VERSION: &str = "0.3.32";
+/// Python packages: (distribution name as pip knows it, requirement to
+/// install, needed for the tests only). A requirement `name==version` is
+/// installed again when another version is found.
+const PYTHON_PACKAGES: &[(&str, &str, bool)] = &[
+    ("fmpy", "fmpy==0.3.32", false),
+    ("numpy", "numpy", false),
+    ("matplotlib", "matplotlib", false),
+    ("pytest", "pytest", true),
+    ("fmu_manipulation_toolbox", "fmu_manipulation_toolbox==2.0", true),
+];
 
 pub fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
@@ -173,8 +179,9 @@ fn python_packages(purpose: Purpose) -> Result<(), String> {
         if *test_only && purpose == Purpose::Run {
             continue;
         }
+        let pinned = req.split_once("==").map(|(_, v)| v);
         match installed_version(dist) {
-            Some(v) if *dist != "fmpy" || v == FMPY_VERSION => {}
+            Some(v) if pinned.is_none_or(|p| p == v) => {}
             _ => missing.push(*req),
         }
     }
