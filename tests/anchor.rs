@@ -365,6 +365,9 @@ fn fmi_outputs_follow_the_anchor() {
     for k in 1..=10 {
         assert_eq!(f.set_f64(vr::ANCHOR_X, &[0.5 + 0.001 * k as f64]), OK);
         f.run(1, 0.01);
+        // read after every step: each step's velocities are computed anew
+        let v = f.f64s(vr::VELOCITIES, x0.len());
+        assert!((v[0] - 0.1).abs() < 1e-9, "after step {k} held node 0 moves with the anchor: {}", v[0]);
     }
     let x = f.positions();
     let v = f.f64s(vr::VELOCITIES, x.len());

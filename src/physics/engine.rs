@@ -314,13 +314,17 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
 }
 
 /// Slot-ordered values into node order, for the nodes whose slot is below
-/// `limit` (the free slots for velocities; every slot for positions). Fixed
-/// length `D` keeps each copy a pair of moves instead of a `memmove` call.
+/// `limit` (the free slots for velocities; every slot for positions); the
+/// other nodes get 0 (held nodes have no velocity of their own: the
+/// anchor's is added to every node afterwards). Fixed length `D` keeps each
+/// copy a pair of moves instead of a `memmove` call.
 fn to_node_order<const D: usize>(slot_of_node: &[usize], limit: usize, from: &[f64], to: &mut [f64]) {
     for (&slot, t) in slot_of_node.iter().zip(to.chunks_exact_mut(D)) {
+        let t = <&mut [f64; D]>::try_from(t).expect("D values");
         if slot < limit {
-            let f: &[f64; D] = from[slot * D..slot * D + D].try_into().expect("D values");
-            *<&mut [f64; D]>::try_from(t).expect("D values") = *f;
+            *t = *<&[f64; D]>::try_from(&from[slot * D..slot * D + D]).expect("D values");
+        } else {
+            *t = [0.0; D];
         }
     }
 }

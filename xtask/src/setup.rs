@@ -10,7 +10,9 @@
 //!   `libsundials-dev`, `libminizip-dev`, `zlib1g-dev` and `libxml2-dev`.
 //! - The Python environment `.venv` in the repository root: fmpy, numpy and
 //!   matplotlib to run the main job; dask.distributed for parameter sweeps
-//!   (`cargo xtask sweep`, python/sweep.py); pytest for the tests.
+//!   (`cargo xtask sweep`, python/sweep.py); for the tests pytest and
+//!   fmu-manipulation-toolbox (its `fmucontainer` is one of the co-simulation
+//!   masters `tests/python/test_chain.py` runs the FMU under).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -50,6 +52,7 @@ const PYTHON_PACKAGES: &[(&str, &str, Purpose)] = &[
     ("matplotlib", "matplotlib", Purpose::Run),
     ("distributed", "dask[distributed]==2026.8.0", Purpose::Sweep),
     ("pytest", "pytest", Purpose::Test),
+    ("fmu_manipulation_toolbox", "fmu_manipulation_toolbox==2.0", Purpose::Test),
 ];
 
 pub fn root() -> PathBuf {

@@ -1,0 +1,363 @@
+"""Two sheets in a chain: sheet B hangs from the load node of sheet A.
+
+    .venv/bin/python python/chain.py [FMU] [--step 0.015625] [--stop-time 3] [--out out/chain.png]
+
+Both sheets are instances of the same FMU. The coupling is
+
+    B.anchor = A.loadNode - A.loadNode(t = 0)    (B's held row follows A's load node)
+    A.load   = B.anchorForce                      (B pulls on A's load node)
+
+The masters here:
+
+- `run_master`: a plain loop over fmpy's FMU3Slave, Jacobi (both sheets step
+  from the outputs at the start of the step) or Gauss-Seidel (A steps first,
+  then B's anchor is set to where A's load node ended the step, then B steps);
+- `fmpy_container`: the same pair packed by fmpy's `container_fmu` (Jacobi)
+  and run as one FMU with `simulate_fmu`;
+- `fmt_container`: the same pair packed by fmu-manipulation-toolbox's
+  `fmucontainer` (Jacobi, or Gauss-Seidel A then B with `sequential`).
+
+A container connects outputs to inputs as they are, so there B's anchor is
+A's load node itself: set in Initialization Mode it places B at rest there,
+and from then on B's anchor moves exactly as A.loadNode - A.loadNode(0) does
+(`anchor="absolute"` makes the plain master do the same).
+"""
+
+import argparse
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# The two sheets (structural and fixed parameters of each instance). B hangs
+# from column 1 of A's bottom row, off A's middle, so that the pair swings
+# sideways as well. Every mode is kept, so the modal basis holds the point
+# load exactly.
+SHEETS = {
+    "A": {"nx": 5, "ny": 4, "nModes": 30, "loadColumn": 1, "springStiffness": 50.0, "nodeMass": 0.05},
+    "B": {"nx": 3, "ny": 3, "nModes": 12, "springStiffness": 10.0, "nodeMass": 0.01},
+}
+# Both sheets: mass-proportional damping [1/s] and one internal step [s] for
+# every communication step size, so runs at different steps differ only in
+# the coupling.
+COMMON = {"dampingAlpha": 5.0, "maxInternalStep": 2.0**-12}
+# The coupling: (output of one sheet, input of the other).
+LINKS = [("A", "loadNodeX", "B", "anchorX"), ("A", "loadNodeY", "B", "anchorY"),
+         ("B", "anchorForceX", "A", "loadX"), ("B", "anchorForceY", "A", "loadY")]
+# Recorded at every communication point, named "sheet.variable".
+RECORDED = [f"{s}.{n}" for s in "AB" for n in
+            ("loadNodeX", "loadNodeY", "anchorForceX", "anchorForceY", "kineticEnergy", "potentialEnergy",
+             "loadX", "loadY", "anchorX", "anchorY")]
+
+
+# Inputs the links set, and the outputs they come from.
+LINKED_INPUTS = {f"{d}.{i}": f"{s}.{o}" for s, o, d, i in LINKS}
+
+
+def default_fmu():
+    return ROOT / "target" / "fmu" / "ModalMassSpring.fmu"
+
+
+def free_mass(sheet):
+    """Mass of the free nodes (every row but the held top row) [kg]."""
+    p = SHEETS[sheet]
+    return (p["ny"] - 1) * p["nx"] * p["nodeMass"]
+
+
+class Sheet:
+    """One instance of the FMU, its variables by name."""
+
+    def __init__(self, fmu, unzipdir, md, name):
+        from fmpy.fmi3 import FMU3Slave
+
+        self.vr = {v.name: v.valueReference for v in md.modelVariables}
+        self.messages = []
+        self.slave = FMU3Slave(guid=md.guid, unzipDirectory=unzipdir,
+                               modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
+        self.slave.instantiate(logMessage=lambda env, status, cat, msg: self.messages.append(msg.decode()))
+        p = SHEETS[name]
+        ints = [k for k, v in p.items() if isinstance(v, int)]
+        floats = [k for k, v in p.items() if isinstance(v, float)] + list(COMMON)
+        self.slave.setUInt64([self.vr[k] for k in ints], [p[k] for k in ints])
+        self.slave.setFloat64([self.vr[k] for k in floats], [{**p, **COMMON}[k] for k in floats])
+
+    def get(self, *names):
+        return self.slave.getFloat64([self.vr[n] for n in names])
+
+    def set(self, names, values):
+        self.slave.setFloat64([self.vr[n] for n in names], list(values))
+
+    def free(self):
+        self.slave.terminate()
+        self.slave.freeInstance()
+
+
+def run_master(fmu, h, stop, scheme="jacobi", anchor="relative", positions=False):
+    """The pair with a plain master at constant communication step h.
+
+    scheme: "jacobi" or "gauss-seidel" (A first). anchor: "relative"
+    (B.anchor = A.loadNode - A.loadNode(0), B starts at its own rest
+    position) or "absolute" (B.anchor = A.loadNode, B starts at rest hanging
+    from A's load node: what a container does). Returns {"time": ...,
+    "A.loadNodeY": ..., ...} at every communication point, t = 0 included;
+    with positions also "A.positions" and "B.positions" (time, ny, nx, 2);
+    "A.restNode", A's load node at rest, and "messages", what the FMUs
+    logged.
+    """
+    from fmpy import extract, read_model_description
+
+    md = read_model_description(str(fmu))
+    unzipdir = extract(str(fmu))
+    a, b = Sheet(fmu, unzipdir, md, "A"), Sheet(fmu, unzipdir, md, "B")
+    sheets = {"A": a, "B": b}
+    try:
+        p0 = np.array(a.get("loadNodeX", "loadNodeY"))
+        offset = np.zeros(2) if anchor == "absolute" else p0
+        if anchor == "absolute":
+            b.set(["anchorX", "anchorY"], p0)
+        for s in (a, b):
+            s.slave.enterInitializationMode(startTime=0.0)
+            s.slave.exitInitializationMode()
+        rows, frames = [], []
+
+        per_sheet = {s: [name[2:] for name in RECORDED if name[0] == s] for s in "AB"}
+
+        def record(t):
+            values = {s: dict(zip(per_sheet[s], sheets[s].get(*per_sheet[s]))) for s in "AB"}
+            rows.append([t] + [values[name[0]][name[2:]] for name in RECORDED])
+            if positions:
+                frames.append([positions_of(sheets[s], s) for s in "AB"])
+
+        def exchange_load():
+            a.set(["loadX", "loadY"], b.get("anchorForceX", "anchorForceY"))
+
+        def exchange_anchor():
+            b.set(["anchorX", "anchorY"], np.array(a.get("loadNodeX", "loadNodeY")) - offset)
+
+        # Inputs are recorded as the master has set them for the next step,
+        # as a container shows them.
+        exchange_load()
+        exchange_anchor()
+        record(0.0)
+        for k in range(int(round(stop / h))):
+            t = k * h
+            if scheme == "jacobi":
+                a.slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+                b.slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+                exchange_load()
+                exchange_anchor()
+            elif scheme == "gauss-seidel":
+                a.slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+                exchange_anchor()
+                b.slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+                exchange_load()
+            else:
+                raise ValueError(f"unknown scheme {scheme}")
+            record((k + 1) * h)
+    finally:
+        a.free()
+        b.free()
+    out = {"time": np.array([r[0] for r in rows])}
+    for j, name in enumerate(RECORDED):
+        out[name] = np.array([r[j + 1] for r in rows])
+    if positions:
+        for i, s in enumerate("AB"):
+            out[f"{s}.positions"] = np.array([f[i] for f in frames])
+    out["A.restNode"] = p0
+    out["messages"] = a.messages + b.messages
+    return out
+
+
+def positions_of(sheet, name):
+    nx, ny = SHEETS[name]["nx"], SHEETS[name]["ny"]
+    return np.array(sheet.slave.getFloat64([sheet.vr["positions"]], nValues=nx * ny * 2)).reshape(ny, nx, 2)
+
+
+def total_energy(r):
+    """Mechanical energy of the pair at every communication point [J].
+
+    Each sheet reports kinetic energy and potential energy (springs, gravity
+    and its point load, relative to its rest state). A's point load is B's
+    pull, an internal force of the pair, whose energy B's outputs already
+    hold: its potential -f . (x - x(0)) is taken out of A's again. What is
+    left is kinetic + elastic + gravitational energy of both sheets.
+    """
+    e = sum(r[f"{s}.kineticEnergy"] + r[f"{s}.potentialEnergy"] for s in "AB")
+    for axis in "XY":
+        e = e + r[f"A.load{axis}"] * (r[f"A.loadNode{axis}"] - r[f"A.loadNode{axis}"][0])
+    return e
+
+
+def _container_variables(md):
+    """(name, type, causality, variability, start, targets) of the container's variables."""
+    rows = []
+    for s, p in SHEETS.items():
+        for k, v in p.items():
+            rows.append((f"{s}.{k}", "UInt64" if isinstance(v, int) else "Float64", "parameter", "fixed", v, [(s, k)]))
+    for k, v in COMMON.items():
+        variability = {v.name: v.variability for v in md.modelVariables}[k]
+        rows.append((k, "Float64", "parameter", variability, v, [("A", k), ("B", k)]))
+    for name in RECORDED:
+        rows.append((name, "Float64", "output", "continuous", None, [(name[0], name[2:])]))
+    return rows
+
+
+def fmpy_container(fmu, h, path):
+    """The pair as one FMU made by fmpy's container_fmu (fmpy 0.3.32):
+    fixedInternalStepSize h, Jacobi. Returns path."""
+    from fmpy import read_model_description
+    from fmpy.container_fmu.cli import create_container_fmu
+    from fmpy.container_fmu.config import Component, Configuration, Connection
+    from fmpy.model_description import CoSimulation, DefaultExperiment, ModelDescription, ModelVariable
+
+    fmu = Path(fmu).resolve()
+    md = read_model_description(str(fmu))
+    var = {v.name: v for v in md.modelVariables}
+    comps = {s: Component(name=s, filename=fmu, modelDescription=md) for s in "AB"}
+    variables = [ModelVariable(type="Float64", variability="continuous", causality="independent", name="time")]
+    mappings = {}
+    for name, typ, causality, variability, start, targets in _container_variables(md):
+        v = ModelVariable(name=name, type=typ, causality=causality, variability=variability,
+                          start=None if start is None else repr(start),
+                          initial="calculated" if causality == "output" else None)
+        variables.append(v)
+        mappings[v] = [(comps[s], var[n]) for s, n in targets]
+    container_md = ModelDescription(fmiVersion="3.0", modelName="Chain", instantiationToken="chain",
+                                    defaultExperiment=DefaultExperiment(stopTime="3", stepSize=repr(h)),
+                                    coSimulation=CoSimulation(fixedInternalStepSize=h), modelVariables=variables)
+    connections = [Connection(comps[s], [var[o]], comps[d], [var[i]]) for s, o, d, i in LINKS]
+    config = Configuration(parallelDoStep=False, modelDescription=container_md, components=list(comps.values()),
+                           connections=connections, variableMappings=mappings)
+    # create_container_fmu empties the directory it is given
+    with tempfile.TemporaryDirectory() as work:
+        create_container_fmu(config, Path(work), Path(path))
+    return path
+
+
+def fmt_container(fmu, h, directory, sequential=False):
+    """The pair as one FMU made by fmu-manipulation-toolbox's fmucontainer
+    (FMI 3.0 interface, internal step h): Jacobi, or Gauss-Seidel A then B
+    with sequential. Returns the path of the container."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    # it names embedded FMUs by file name: one file per instance
+    for s in "AB":
+        (directory / f"{s}.fmu").write_bytes(Path(fmu).read_bytes())
+    lines = ["rule;from_fmu;from_port;to_fmu;to_port", "FMU;A.fmu;;;", "FMU;B.fmu;;;"]
+    lines += [f"LINK;{s}.fmu;{o};{d}.fmu;{i}" for s, o, d, i in LINKS]
+    for s, p in SHEETS.items():
+        lines += [f"START;{s}.fmu;{k};{v!r};" for k, v in {**p, **COMMON}.items()]
+    # it exposes outputs of the embedded FMUs only (an input as output is refused)
+    from fmpy import read_model_description
+
+    causality = {v.name: v.causality for v in read_model_description(str(fmu)).modelVariables}
+    lines += [f"OUTPUT;{name[0]}.fmu;{name[2:]};;{name}" for name in RECORDED if causality[name[2:]] == "output"]
+    name = "chain_sequential" if sequential else "chain"
+    (directory / f"{name}.csv").write_text("\n".join(lines) + "\n")
+    cmd = [sys.executable, "-m", "fmu_manipulation_toolbox.cli.fmucontainer", "-container", f"{name}.csv:{h!r}",
+           "-fmi", "3", "-fmu-directory", str(directory), "-no-auto-input", "-no-auto-output", "-no-auto-link"]
+    if sequential:
+        cmd.append("-sequential")
+    done = subprocess.run(cmd, cwd=directory, capture_output=True, text=True)
+    path = directory / f"{name}.fmu"
+    if done.returncode != 0 or not path.exists():
+        raise RuntimeError(f"{' '.join(cmd)} failed ({done.returncode}):\n{done.stdout}\n{done.stderr}")
+    return path
+
+
+def run_container(path, h, stop):
+    """simulate_fmu on a container, output every communication step; the
+    same names as run_master. Log messages in "messages"."""
+    from fmpy import simulate_fmu
+
+    messages = []
+    from fmpy import read_model_description
+
+    names = {v.name for v in read_model_description(str(path)).modelVariables}
+    res = simulate_fmu(str(path), stop_time=stop, output_interval=h, output=[n for n in RECORDED if n in names],
+                       logger=lambda env, status, cat, msg: messages.append((status, cat.decode(), msg.decode())))
+    out = {name: np.asarray(res[name]) for name in res.dtype.names}
+    for name, source in LINKED_INPUTS.items():
+        # the container sets each linked input to its source at every communication point
+        if source in out:
+            out.setdefault(name, out[source])
+    out["messages"] = messages
+    return out
+
+
+def plot(r, path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
+
+    t = r["time"]
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4))
+    # the sheets at rest, at B's lowest point and at the end; B drawn hanging
+    # from A's load node, centred under it
+    ax = axes[0]
+    dx = -(SHEETS["B"]["nx"] - 1) / 2 * 0.1
+    lowest = int(np.argmin(r["B.loadNodeY"]))
+    frames = [(0, ":", 0.5), (lowest, "--", 0.7), (len(t) - 1, "-", 1.0)]
+    for k, style, alpha in frames:
+        for s, colour in (("A", "C0"), ("B", "C1")):
+            x = r[f"{s}.positions"][k].copy()
+            if s == "B":
+                x[..., 0] += r["A.restNode"][0] + dx
+                x[..., 1] += r["A.restNode"][1]
+            ax.plot(x[..., 0], x[..., 1], style, color=colour, alpha=alpha, lw=0.9)
+            ax.plot(x[..., 0].T, x[..., 1].T, style, color=colour, alpha=alpha, lw=0.9)
+    ax.legend([Line2D([], [], ls=style, color="k") for _, style, _ in frames],
+              [f"t = {t[k]:.2f} s" for k, _, _ in frames], fontsize=8, loc="lower right")
+    ax.set_aspect("equal")
+    ax.set_title("A (blue) holding B (orange)")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax = axes[1]
+    ax.plot(t, r["A.loadNodeY"] - r["A.loadNodeY"][0], label="A's load node")
+    ax.plot(t, r["B.loadNodeY"] - r["B.loadNodeY"][0], label="B's load node")
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("y displacement [m]")
+    twin = ax.twinx()
+    twin.plot(t, -r["A.loadY"], color="C2", lw=0.8, label="B's pull on A [N]")
+    twin.set_ylabel("B's pull on A [N]")
+    lines = ax.get_lines() + twin.get_lines()
+    ax.legend(lines, [line.get_label() for line in lines], fontsize=8, loc="lower right")
+    ax = axes[2]
+    ax.semilogy(t[1:], (r["A.kineticEnergy"] + r["B.kineticEnergy"])[1:], label="kinetic")
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("kinetic energy [J]")
+    twin = ax.twinx()
+    twin.plot(t, total_energy(r), color="C3", label="kinetic + potential")
+    twin.set_ylabel("energy of the pair [J]")
+    lines = ax.get_lines() + twin.get_lines()
+    ax.legend(lines, [line.get_label() for line in lines], fontsize=8, loc="upper right")
+    ax.set_title(f"damping {COMMON['dampingAlpha']:g} 1/s")
+    fig.tight_layout()
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=100)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("fmu", nargs="?", default=str(default_fmu()))
+    ap.add_argument("--step", type=float, default=2.0**-6, help="communication step [s]")
+    ap.add_argument("--stop-time", type=float, default=3.0)
+    ap.add_argument("--out", default=str(ROOT / "out" / "chain.png"))
+    args = ap.parse_args(argv)
+    r = run_master(args.fmu, args.step, args.stop_time, scheme="gauss-seidel", positions=True)
+    e = total_energy(r)
+    print(f"chain, Gauss-Seidel, h = {args.step} s: at t = {r['time'][-1]:.2f} s A's load node sags "
+          f"{r['A.loadNodeY'][0] - r['A.loadNodeY'][-1]:.4f} m, B pulls with {-r['A.loadY'][-1]:.4f} N "
+          f"(B's weight {free_mass('B') * 9.81:.4f} N), energy {e[-1]:.5f} J")
+    plot(r, args.out)
+    print(f"plot: {args.out}")
+
+
+if __name__ == "__main__":
+    main()
