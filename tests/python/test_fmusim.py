@@ -249,31 +249,43 @@ def test_communication_steps(split_runs):
 # that step: fmusim only at exactly that time, fmpy within isclose. The values
 # are 0 and powers of two: between rows fmpy interpolates as
 # w0 v0 + (1 - w0) v1, which returns v0 = v1 exactly only for those.
-LOAD_SCHEDULE = [(0, 0.0, 0.0), (30, 0.125, 0.0), (50, 0.125, -0.25), (90, -0.25, -0.25), (120, -0.25, 0.125), (140, 0.0, 0.125), (160, 0.0, 0.0)]
+# (step, loadX, loadY, anchorX): the point load and the anchor's target, both
+# exact in binary so that fmpy's interpolation weights give them back exactly.
+LOAD_SCHEDULE = [
+    (0, 0.0, 0.0, 0.0),
+    (30, 0.125, 0.0, 0.0),
+    (40, 0.125, 0.0, 2.0**-7),
+    (50, 0.125, -0.25, 2.0**-7),
+    (70, 0.125, -0.25, -(2.0**-6)),
+    (90, -0.25, -0.25, -(2.0**-6)),
+    (120, -0.25, 0.125, 0.0),
+    (140, 0.0, 0.125, 0.0),
+    (160, 0.0, 0.0, 0.0),
+]
 
 
 def load_rows():
     rows = []
-    for k, fx, fy in LOAD_SCHEDULE:
+    for k, *values in LOAD_SCHEDULE:
         if rows:
             rows.append((k * H,) + rows[-1][1:])
-        rows.append((k * H, fx, fy))
+        rows.append((k * H, *values))
     rows.append((STOP,) + rows[-1][1:])
     return rows
 
 
 def load_at(step):
-    """(loadX, loadY) in force over communication step `step`."""
-    return next((fx, fy) for k, fx, fy in reversed(LOAD_SCHEDULE) if k <= step)
+    """(loadX, loadY, anchorX) set for communication step `step`."""
+    return next(tuple(values) for k, *values in reversed(LOAD_SCHEDULE) if k <= step)
 
 
 def test_input_file_matches_fmpy(fmusim, default_fmu, default_md, tmp_path):
-    """The point load driven from a CSV file (--input-file) and from fmpy's
-    input array: fmusim sets the scheduled load before every step, and the
+    """The point load and the anchor driven from a CSV file (--input-file) and
+    from fmpy's input array: fmusim sets the scheduled inputs before every step, and the
     results equal fmpy's to the digits fmusim writes."""
     rows = load_rows()
     input_csv = tmp_path / "load.csv"
-    input_csv.write_text("time,loadX,loadY\n" + "".join(",".join(repr(float(v)) for v in r) + "\n" for r in rows))
+    input_csv.write_text("time,loadX,loadY,anchorX\n" + "".join(",".join(repr(float(v)) for v in r) + "\n" for r in rows))
     run = fmusim_run(fmusim, default_fmu, tmp_path, "load", "--stop-time", str(STOP), "--input-file", str(input_csv), log=True)
 
     # what fmusim set before each step
@@ -283,11 +295,11 @@ def test_input_file_matches_fmpy(fmusim, default_fmu, default_md, tmp_path):
         if m := SET_FLOAT64.match(line):
             current[int(m.group(1))] = float(m.group(2))
         elif DO_STEP.match(line):
-            applied.append((current.get(vr["loadX"]), current.get(vr["loadY"])))
+            applied.append((current.get(vr["loadX"]), current.get(vr["loadY"]), current.get(vr["anchorX"])))
     assert applied == [load_at(k) for k in range(round(STOP / H))]
 
     names = outputs(default_md)
-    signals = np.array(rows, dtype=[("time", np.float64), ("loadX", np.float64), ("loadY", np.float64)])
+    signals = np.array(rows, dtype=[("time", np.float64), ("loadX", np.float64), ("loadY", np.float64), ("anchorX", np.float64)])
     ref = simulate_fmu(default_fmu, stop_time=STOP, output_interval=H, input=signals, output=names)
     assert_same_as_fmpy(run, ref)
 
