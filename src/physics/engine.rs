@@ -62,7 +62,7 @@ pub trait Stepper: Send {
     /// Node positions of `state` (whose forces were evaluated last) into
     /// `out.positions`, and the anchor force (which follows from them).
     fn node_positions(&mut self, state: &State, out: &mut Outputs);
-    /// Node velocities of `state` into `out.velocities` (held nodes stay at 0).
+    /// Node velocities of `state` into `out.velocities` (held nodes at 0).
     fn node_velocities(&mut self, state: &State, out: &mut Outputs);
     /// Position of one node of `state` (whose forces were evaluated last),
     /// without the others; z is 0 in 2D.
@@ -314,13 +314,12 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
 }
 
 /// Slot-ordered values into node order, for the nodes whose slot is below
-/// `limit` (the free slots for velocities; every slot for positions). Fixed
+/// `limit` (the free slots for velocities; every slot for positions); the
+/// other nodes get 0 (a held node's velocity relative to the anchor). Fixed
 /// length `D` keeps each copy a pair of moves instead of a `memmove` call.
 fn to_node_order<const D: usize>(slot_of_node: &[usize], limit: usize, from: &[f64], to: &mut [f64]) {
     for (&slot, t) in slot_of_node.iter().zip(to.chunks_exact_mut(D)) {
-        if slot < limit {
-            let f: &[f64; D] = from[slot * D..slot * D + D].try_into().expect("D values");
-            *<&mut [f64; D]>::try_from(t).expect("D values") = *f;
-        }
+        let t = <&mut [f64; D]>::try_from(t).expect("D values");
+        *t = if slot < limit { from[slot * D..slot * D + D].try_into().expect("D values") } else { [0.0; D] };
     }
 }
