@@ -411,6 +411,27 @@ fn fmi_state_with_a_moving_anchor_resumes_bit_for_bit() {
     f.free_state(st2);
 }
 
+/// Held nodes move with the anchor at its rate over the last step, whatever
+/// rates came before it, and after a restored state at that state's rate.
+#[test]
+fn held_nodes_move_at_the_anchor_rate_of_the_step() {
+    let mut sim = scenes::canonical("paper-2d-top-row").unwrap().simulator().unwrap();
+    sim.do_step(0.02).unwrap();
+    let start = sim.snapshot();
+    for (k, target) in [0.01, 0.03, 0.02].into_iter().enumerate() {
+        let mut loads = sim.loads().clone();
+        loads.anchor[0] = target;
+        sim.set_loads(&loads).unwrap();
+        let before = sim.snapshot().state.anchor[0];
+        sim.do_step(0.02).unwrap();
+        let rate = (target - before) / 0.02;
+        let held = sim.velocities()[0];
+        assert!((held - rate).abs() < 1e-12, "step {k}: held node at {held} m/s, the anchor at {rate} m/s");
+    }
+    sim.restore(&start).unwrap();
+    assert_eq!(sim.velocities()[0], 0.0, "a held node after the restored state");
+}
+
 /// The load node's position and velocity and the anchor force, read
 /// without the node positions (one node, the springs on the held nodes),
 /// are the bits read after the positions, in every space and force model.

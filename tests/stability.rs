@@ -1,6 +1,7 @@
 //! The stability matrix: every canonical scene across stiff and extreme
-//! cases, with both integrators and both reductions, through the fmi3 C
-//! functions as a host calls them.
+//! cases, with both Newmark integrators and both reductions, and the
+//! trigonometric integrator in modal space, through the fmi3 C functions as
+//! a host calls them.
 //!
 //! Every cell must end in one of three ways:
 //! - **stable**: every step returned fmi3OK, every output stayed finite and
@@ -84,7 +85,7 @@ struct Extreme {
     applies: fn(&SceneDef) -> bool,
     /// Parameters (value reference, value) set in the Instantiated state.
     set: fn(&SceneDef) -> Vec<(u32, Value)>,
-    /// Simulated time [s] for (scene, implicit).
+    /// Simulated time [s] for (scene, implicit Newmark).
     t_end: fn(&SceneDef, bool) -> f64,
     /// Communication steps, used in turn [s].
     steps: &'static [f64],
@@ -476,7 +477,7 @@ fn stretch(p: &[f64], s: &SceneDef, nx: usize, spacing: f64) -> f64 {
     m
 }
 
-fn run_cell(e: &Extreme, s: &SceneDef, modal: bool, implicit: bool) -> Cell {
+fn run_cell(e: &Extreme, s: &SceneDef, modal: bool, integrator: i64) -> Cell {
     let na = Cell { outcome: Outcome::NotApplicable, samples: Vec::new(), initial: Vec::new() };
     if !(e.applies)(s) {
         return na;
@@ -491,7 +492,7 @@ fn run_cell(e: &Extreme, s: &SceneDef, modal: bool, implicit: bool) -> Cell {
         (vr::FIXED_NODES, I(s.fixed)),
         (vr::AUX_STIFFNESS, F(vec![s.aux])),
         (vr::REDUCTION, I(if modal { 1 } else { 2 })),
-        (vr::INTEGRATOR, I(if implicit { 2 } else { 1 })),
+        (vr::INTEGRATOR, I(integrator)),
     ];
     params.extend((e.set)(s));
     for (r, v) in &params {
@@ -511,7 +512,7 @@ fn run_cell(e: &Extreme, s: &SceneDef, modal: bool, implicit: bool) -> Cell {
     let work = f.f64s(vr::NODE_MASS, 1)[0] * (nx * ny) as f64 * g_start.iter().map(|c| c * c).sum::<f64>().sqrt() * spacing * ny as f64;
     let energy = |f: &Fmu| f.f64s(vr::KINETIC_ENERGY, 1)[0] + f.f64s(vr::POTENTIAL_ENERGY, 1)[0];
     let initial = f.positions();
-    let t_end = (e.t_end)(s, implicit);
+    let t_end = (e.t_end)(s, integrator == 2);
     let mut samples = Vec::new();
     let (mut e0, mut k_max, mut drift, mut max_stretch) = (energy(&f), 0.0f64, 0.0f64, 0.0f64);
     let mut warned = None;
@@ -589,13 +590,20 @@ fn short(o: &Outcome) -> String {
     }
 }
 
-const COLUMNS: [(bool, bool, &str); 4] =
-    [(true, false, "modal, explicit"), (true, true, "modal, implicit"), (false, false, "full, explicit"), (false, true, "full, implicit")];
+/// (modal, value of `integrator`, label, the full-space column a modal one is compared with).
+const COLUMNS: [(bool, i64, &str, usize); 5] = [
+    (true, 1, "modal, explicit", 2),
+    (true, 2, "modal, implicit", 3),
+    (false, 1, "full, explicit", 2),
+    (false, 2, "full, implicit", 3),
+    (true, 3, "modal, trigonometric", 2),
+];
 
 #[test]
 fn stability_matrix() {
     let extremes = extremes();
-    let jobs: Vec<(usize, usize, usize)> = (0..extremes.len()).flat_map(|e| (0..SCENES.len()).flat_map(move |s| (0..4).map(move |c| (e, s, c)))).collect();
+    let jobs: Vec<(usize, usize, usize)> =
+        (0..extremes.len()).flat_map(|e| (0..SCENES.len()).flat_map(move |s| (0..COLUMNS.len()).map(move |c| (e, s, c)))).collect();
     let next = Mutex::new(0usize);
     let results: Mutex<Vec<Option<Cell>>> = Mutex::new((0..jobs.len()).map(|_| None).collect());
     let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
@@ -608,9 +616,9 @@ fn stability_matrix() {
                     *n - 1
                 };
                 let Some(&(e, s, c)) = jobs.get(j) else { break };
-                let (modal, implicit, column) = COLUMNS[c];
+                let (modal, integrator, column, _) = COLUMNS[c];
                 let clock = std::time::Instant::now();
-                let cell = run_cell(&extremes[e], &SCENES[s], modal, implicit);
+                let cell = run_cell(&extremes[e], &SCENES[s], modal, integrator);
                 let seconds = clock.elapsed().as_secs_f64();
                 if seconds > 1.0 {
                     eprintln!("{seconds:6.1} s  {} / {} / {column}", extremes[e].label, SCENES[s].name);
@@ -620,16 +628,16 @@ fn stability_matrix() {
         }
     });
     let cells: Vec<Cell> = results.into_inner().unwrap().into_iter().map(|c| c.unwrap()).collect();
-    let cell = |e: usize, s: usize, c: usize| &cells[(e * SCENES.len() + s) * 4 + c];
+    let cell = |e: usize, s: usize, c: usize| &cells[(e * SCENES.len() + s) * COLUMNS.len() + c];
 
     let mut table = String::new();
     let mut refusals = String::new();
     writeln!(table, "| extreme | scene | {} |", COLUMNS.map(|c| c.2).join(" | ")).unwrap();
-    writeln!(table, "|---|---|---|---|---|---|").unwrap();
+    writeln!(table, "|---|---|{}", "---|".repeat(COLUMNS.len())).unwrap();
     for (ei, e) in extremes.iter().enumerate() {
         for (si, s) in SCENES.iter().enumerate() {
             let mut row = format!("| {} | {} |", e.label, s.name);
-            for c in 0..4 {
+            for (c, &(modal, _, label, partner)) in COLUMNS.iter().enumerate() {
                 let x = cell(ei, si, c);
                 let mut text = short(&x.outcome);
                 match &x.outcome {
@@ -640,8 +648,8 @@ fn stability_matrix() {
                         }
                         if e.compare {
                             text += &format!(" · stretch {:.0} %", stretch * 100.0);
-                            let full = cell(ei, si, c + 2);
-                            if c < 2 && matches!(full.outcome, Outcome::Stable { .. }) {
+                            let full = cell(ei, si, partner);
+                            if modal && matches!(full.outcome, Outcome::Stable { .. }) {
                                 text += &format!(" · E vs full {:.2}", trajectory_error(&x.samples, &full.samples, &full.initial));
                             }
                         }
@@ -650,7 +658,7 @@ fn stability_matrix() {
                     _ => {}
                 }
                 if let Outcome::Refused { message, .. } | Outcome::Discarded { message, .. } = &x.outcome {
-                    let line = format!("- {} / {} / {}: {message}\n", e.label, s.name, COLUMNS[c].2);
+                    let line = format!("- {} / {} / {label}: {message}\n", e.label, s.name);
                     if !refusals.contains(message.as_str()) {
                         refusals += &line;
                     }

@@ -113,12 +113,23 @@ pub fn describe(e: &PhysicsError, p: &Params) -> String {
              use forceEvaluation = exact"
         ),
         SetupDataMismatch { .. } => e.to_string(),
+        SchemeNeedsDiagonal { scheme } => format!(
+            "{} integrates the linear oscillator of every mode exactly and needs reduction = {}: with reduction = {} the \
+             stiffness and the damping couple every degree of freedom; use reduction = {}, or {} or {} in full space",
+            integrator(*scheme),
+            Reduction::Modal.name(),
+            Reduction::Full.name(),
+            Reduction::Modal.name(),
+            integrator(Integrator::NewmarkExplicit),
+            integrator(Integrator::NewmarkImplicit),
+        ),
         SnapshotLength { len, expected } => format!("the state holds {len} values per array, this scene needs {expected}"),
         SnapshotNotFinite => "the state holds non-finite values".into(),
     }
 }
 
 fn failure(cause: &StepFailure) -> String {
+    let integrator = |i: Integrator| format!("integrator = {}", i.name());
     match cause {
         StepFailure::NonFinite { .. } | StepFailure::EnergyGrowth { .. } | StepFailure::SingularNewton { .. } => cause.to_string(),
         StepFailure::AnchorTooFast { speed, limit, dt } => format!(
@@ -130,5 +141,13 @@ fn failure(cause: &StepFailure) -> String {
             format!("implicit Newmark: Newton did not converge in {iterations} iterations at dt = {dt:e} s; reduce maxInternalStep")
         }
         StepFailure::Buckled => "the full-space Newmark matrix is singular (springs in compression buckle); reduce maxInternalStep".into(),
+        StepFailure::RestTooStiff { stiffness, limit, dt } => format!(
+            "{}: the force beyond the modes' own springs (springs stretched or compressed far from rest) stiffened to {stiffness:.3e} \
+             1/s^2 along the step, above the {limit:.3e} 1/s^2 its explicit part follows at internal steps of {dt:e} s; use a \
+             shorter communication step or maxInternalStep (below {:.3e} s), or {}",
+            integrator(Integrator::Trigonometric),
+            2.0 / stiffness.sqrt(),
+            integrator(Integrator::NewmarkExplicit),
+        ),
     }
 }

@@ -7,7 +7,7 @@
 use std::marker::PhantomData;
 
 use super::bake::SetupData;
-use super::error::StepFailure;
+use super::error::{PhysicsError, StepFailure};
 use super::integrator::{Buffers, Scheme};
 use super::scene::Scene;
 use super::space::Space;
@@ -35,8 +35,9 @@ pub trait Stepper: Send {
     /// The coordinates of the scene at rest.
     fn rest_coordinates(&self, y: &mut [f64]);
     /// Evaluates the forces at `state.y` (positions and elastic energy
-    /// follow it) and sets `state.a` from them: at the start, and after a
-    /// change of loads, which then acts as a step input.
+    /// follow it) and sets `state.a` as the scheme needs it (see
+    /// [`Scheme::settle`]): at the start, and after a change of loads, which
+    /// then acts as a step input.
     fn settle(&mut self, loads: &Loads, state: &mut State);
     /// Evaluates the forces at `state.y` only (after a restore, which
     /// brings its own accelerations).
@@ -46,9 +47,12 @@ pub trait Stepper: Send {
     fn spring_force(&mut self, loads: &Loads, state: &State, y: &[f64], out: &mut [f64]);
     /// One internal step of length `dt`.
     fn step(&mut self, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure>;
+    /// After the internal steps of a communication step: the forces
+    /// evaluated at `state.y` (see [`Scheme::finish`]).
+    fn finish(&mut self, loads: &Loads, state: &State);
     /// Adds the rates of a rigid translation with velocity `c` to
     /// `state.v` (see [`Space::add_translation_rate`]) and sets `state.a`
-    /// for the new rates.
+    /// for the new rates (see [`Scheme::settle_rates`]).
     fn translate_rates(&mut self, loads: &Loads, c: &[f64; 3], state: &mut State);
     /// Momentum of the free nodes per axis, relative to the anchor [kg m/s].
     fn momentum(&self, state: &State) -> [f64; 3];
@@ -62,7 +66,7 @@ pub trait Stepper: Send {
     /// Node positions of `state` (whose forces were evaluated last) into
     /// `out.positions`, and the anchor force (which follows from them).
     fn node_positions(&mut self, state: &State, out: &mut Outputs);
-    /// Node velocities of `state` into `out.velocities` (held nodes stay at 0).
+    /// Node velocities of `state` into `out.velocities` (held nodes at 0).
     fn node_velocities(&mut self, state: &State, out: &mut Outputs);
     /// Position of one node of `state` (whose forces were evaluated last),
     /// without the others; z is 0 in 2D.
@@ -128,9 +132,12 @@ pub struct Engine<S: Space, I: Scheme> {
 }
 
 impl<S: Space, I: Scheme> Engine<S, I> {
-    pub fn new(space: S) -> Self {
+    /// Binds `space` to the scheme, or refuses a space the scheme cannot integrate.
+    pub fn new(space: S) -> Result<Self, PhysicsError> {
         let anchors = anchor_springs(space.scene());
-        Engine { work: space.work(), buffers: Buffers::new(space.coordinates()), anchors, space, scheme: PhantomData }
+        let work = space.work();
+        I::check(&space, &work)?;
+        Ok(Engine { work, buffers: Buffers::new(space.coordinates(), I::SCRATCH), anchors, space, scheme: PhantomData })
     }
 }
 
@@ -216,12 +223,13 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
     }
 
     fn settle(&mut self, loads: &Loads, state: &mut State) {
-        self.space.force(loads, &state.y, &mut self.work, &mut self.buffers.h);
-        self.space.acceleration(&state.v, &self.buffers.h, &mut self.work, &mut state.a);
+        I::settle(&self.space, &mut self.work, &mut self.buffers, loads, state);
     }
 
     fn evaluate(&mut self, loads: &Loads, state: &State) {
         self.space.force(loads, &state.y, &mut self.work, &mut self.buffers.h);
+        // A restored state.a was derived for a step size the buffers do not know.
+        self.buffers.filter_step = f64::NAN;
     }
 
     fn spring_force(&mut self, loads: &Loads, state: &State, y: &[f64], out: &mut [f64]) {
@@ -233,9 +241,13 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
         I::step(&self.space, &mut self.work, &mut self.buffers, loads, state, dt)
     }
 
+    fn finish(&mut self, loads: &Loads, state: &State) {
+        I::finish(&self.space, &mut self.work, &mut self.buffers, loads, state);
+    }
+
     fn translate_rates(&mut self, loads: &Loads, c: &[f64; 3], state: &mut State) {
         self.space.add_translation_rate(loads, c, &mut state.v);
-        self.settle(loads, state);
+        I::settle_rates(&self.space, &mut self.work, &mut self.buffers, loads, state);
     }
 
     fn momentum(&self, state: &State) -> [f64; 3] {

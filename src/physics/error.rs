@@ -8,6 +8,8 @@
 
 use std::fmt;
 
+use super::integrator::Integrator;
+
 /// A quantity of the scene, the solver, the loads or a step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Quantity {
@@ -116,6 +118,12 @@ pub enum StepFailure {
     /// The full-space Newton matrix is singular even as LDL^T (springs in
     /// compression buckle).
     Buckled,
+    /// The trigonometric scheme: along the step, the part of the force
+    /// beyond the modes' own springs changed as a stiffness `stiffness`
+    /// [1/s^2] above `limit` = 4 / dt^2, beyond what its explicit kicks can
+    /// follow (springs stretched or compressed far from rest stiffen modes
+    /// whose own springs are soft).
+    RestTooStiff { stiffness: f64, limit: f64, dt: f64 },
     /// The anchor's velocity changes by `speed` at the start of the step:
     /// the sheet would move relative to it by more than half the spacing in
     /// one internal step of `dt` (`docs/method.md`, section 8).
@@ -190,6 +198,10 @@ pub enum PhysicsError {
     CubatureTrainingDiverged { time: f64 },
     /// Stored set-up data that does not fit the scene and solver.
     SetupDataMismatch { what: &'static str },
+    /// The scheme integrates the linear oscillator of every coordinate
+    /// exactly and needs a space whose linear part is diagonal (the modal
+    /// space); the full space's stiffness and damping couple its coordinates.
+    SchemeNeedsDiagonal { scheme: Integrator },
     /// A snapshot whose arrays do not fit this simulator.
     SnapshotLength { len: usize, expected: usize },
     /// A snapshot holding NaN or infinite values.
@@ -208,6 +220,11 @@ impl fmt::Display for StepFailure {
             }
             StepFailure::SingularNewton { dt } => write!(f, "implicit Newmark: singular Newton matrix at dt = {dt:e} s"),
             StepFailure::Buckled => f.write_str("the full-space Newmark matrix is singular (springs in compression buckle); shorten the internal steps"),
+            StepFailure::RestTooStiff { stiffness, limit, dt } => write!(
+                f,
+                "trigonometric scheme: the force beyond the modes' own springs stiffened to {stiffness:.3e} 1/s^2 along the step, \
+                 above the {limit:.3e} 1/s^2 its explicit part follows at dt = {dt:e} s; shorten the internal steps"
+            ),
             StepFailure::AnchorTooFast { speed, limit, dt } => write!(
                 f,
                 "the anchor's velocity changes by {speed:e} m/s at the start of the step: the sheet would move relative to it by more \
@@ -288,6 +305,12 @@ impl fmt::Display for PhysicsError {
                  use the implicit integrator, fewer modes or a shorter communication step"
             ),
             StepFailed { time, cause } => write!(f, "step from t = {time} s failed: {cause}"),
+            SchemeNeedsDiagonal { scheme } => write!(
+                f,
+                "the {} integrator integrates the linear oscillator of every mode exactly and needs the modal space; \
+                 in full space the stiffness and the damping couple the coordinates",
+                scheme.name()
+            ),
             SnapshotLength { len, expected } => write!(f, "the snapshot holds {len} state values, this simulator needs {expected}"),
             SnapshotNotFinite => f.write_str("the snapshot holds non-finite values"),
         }

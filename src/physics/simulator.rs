@@ -234,6 +234,9 @@ impl Simulator {
                 break;
             }
         }
+        if result.is_ok() {
+            self.engine.finish(&self.loads, &self.state);
+        }
         if let Err(cause) = result.and_then(|_| self.check_state(dt, energy_before)) {
             self.state.copy_from(&self.backup);
             self.engine.evaluate(&self.loads, &self.state);

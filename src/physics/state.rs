@@ -21,7 +21,8 @@ pub struct State {
     pub y: Vec<f64>,
     /// y'.
     pub v: Vec<f64>,
-    /// y''.
+    /// y'' (Newmark); the trigonometric scheme keeps the rest of its force
+    /// at the filtered coordinates, e(phi y), here instead (`docs/method.md`, section 4).
     pub a: Vec<f64>,
     /// Displacement of the anchor (every held node) from its rest position
     /// at `time` [m]; z is 0 in 2D. y measures the free DOFs from the

@@ -120,9 +120,9 @@ def test_structural_parameters_fixed_after_initialization(new_instance):
 
 
 def test_enumerations_select_the_model(new_instance):
-    """reduction = full, integrator = newmark-implicit (Enumerations, Set/GetInt64)."""
+    """reduction = full, integrator = newmark-implicit or trigonometric (Enumerations, Set/GetInt64)."""
     runs = {}
-    for reduction, integrator in ((1, 1), (2, 1), (1, 2), (2, 2)):
+    for reduction, integrator in ((1, 1), (2, 1), (1, 2), (2, 2), (1, 3)):
         inst = new_instance(f"r{reduction}i{integrator}")
         inst.slave.setInt64([inst.vr["reduction"], inst.vr["integrator"]], [reduction, integrator])
         inst.initialize()
@@ -135,8 +135,15 @@ def test_enumerations_select_the_model(new_instance):
     # the full-space run differs from the two-mode run
     assert not np.array_equal(runs[(1, 1)], runs[(2, 1)])
     assert not np.array_equal(runs[(1, 1)], runs[(1, 2)])
+    assert not np.array_equal(runs[(1, 1)], runs[(1, 3)])
     with pytest.raises(FMICallException):
         new_instance().slave.setInt64([inst.vr["reduction"]], [3])
+    # the trigonometric integrator needs the modal space: refused at set-up, naming both variables
+    inst = new_instance("r2i3")
+    inst.slave.setInt64([inst.vr["reduction"], inst.vr["integrator"]], [2, 3])
+    with pytest.raises(FMICallException):
+        inst.initialize()
+    assert any("integrator" in m and "reduction" in m for _, _, m in inst.messages), inst.messages
 
 
 def test_top_corners(new_instance):

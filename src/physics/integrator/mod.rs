@@ -7,12 +7,14 @@
 
 mod newmark_explicit;
 mod newmark_implicit;
+mod trigonometric;
 
 pub use newmark_explicit::NewmarkExplicit;
 pub use newmark_implicit::NewmarkImplicit;
+pub use trigonometric::{Propagator, Trigonometric};
 
 use super::engine::{Engine, Stepper};
-use super::error::StepFailure;
+use super::error::{PhysicsError, StepFailure};
 use super::space::Space;
 use super::state::{Loads, State};
 pub use crate::options::Integrator;
@@ -30,6 +32,34 @@ pub trait Scheme: Send + 'static {
     /// Advances `state` (not its time) by `dt`. On error `state` may hold
     /// anything; the caller restores its backup.
     fn step<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure>;
+
+    /// Values per coordinate the scheme keeps in [`Buffers::scheme`].
+    const SCRATCH: usize = 0;
+
+    /// Refuses, at set-up, a space the scheme cannot integrate.
+    fn check<S: Space>(_space: &S, _w: &S::Work) -> Result<(), PhysicsError> {
+        Ok(())
+    }
+
+    /// Makes `state.a` what the scheme's next step expects of a state with
+    /// coordinates `state.y` and rates `state.v` under `loads` (at the start,
+    /// after a change of loads), and leaves the forces of `w` evaluated at
+    /// `state.y`. Newmark: the acceleration, M a = h(y) - C v.
+    fn settle<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, loads: &Loads, state: &mut State) {
+        space.force(loads, &state.y, w, &mut buf.h);
+        space.acceleration(&state.v, &buf.h, w, &mut state.a);
+    }
+
+    /// The same after a change of the rates alone (the anchor's kick,
+    /// `docs/method.md`, section 8), with the forces of `w` evaluated at `state.y`.
+    fn settle_rates<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, loads: &Loads, state: &mut State) {
+        Self::settle(space, w, buf, loads, state);
+    }
+
+    /// After the internal steps of a communication step: leaves the forces
+    /// of `w` evaluated at `state.y`, where the outputs and the step guard
+    /// read them. Nothing for a scheme whose last evaluation is there.
+    fn finish<S: Space>(_space: &S, _w: &mut S::Work, _buf: &mut Buffers, _loads: &Loads, _state: &State) {}
 }
 
 /// Vectors of the generalized coordinates' length that a step works in.
@@ -42,20 +72,37 @@ pub struct Buffers {
     pub h: Vec<f64>,
     /// Newton residual and update.
     pub r: Vec<f64>,
+    /// The step size for which `state.a` holds what a scheme keeps there
+    /// when that depends on the step size (the trigonometric scheme's
+    /// filtered force); NaN when unknown, as after a restored state.
+    pub filter_step: f64,
+    /// [`Scheme::SCRATCH`] values per coordinate for the scheme's own use.
+    pub scheme: Vec<f64>,
 }
 
 impl Buffers {
-    pub fn new(n: usize) -> Self {
-        Buffers { y1: vec![0.0; n], v1: vec![0.0; n], a1: vec![0.0; n], h: vec![0.0; n], r: vec![0.0; n] }
+    /// For `n` coordinates and `scratch` values per coordinate of [`Buffers::scheme`].
+    pub fn new(n: usize, scratch: usize) -> Self {
+        Buffers {
+            y1: vec![0.0; n],
+            v1: vec![0.0; n],
+            a1: vec![0.0; n],
+            h: vec![0.0; n],
+            r: vec![0.0; n],
+            filter_step: f64::NAN,
+            scheme: vec![f64::NAN; n * scratch],
+        }
     }
 }
 
-/// The registry of schemes: binds `space` to the scheme `kind` names.
-pub(crate) fn bind<S: Space>(space: S, kind: Integrator) -> Box<dyn Stepper> {
-    match kind {
-        Integrator::NewmarkExplicit => Box::new(Engine::<S, NewmarkExplicit>::new(space)),
-        Integrator::NewmarkImplicit => Box::new(Engine::<S, NewmarkImplicit>::new(space)),
-    }
+/// The registry of schemes: binds `space` to the scheme `kind` names, or
+/// refuses a pair the scheme cannot integrate.
+pub(crate) fn bind<S: Space>(space: S, kind: Integrator) -> Result<Box<dyn Stepper>, PhysicsError> {
+    Ok(match kind {
+        Integrator::NewmarkExplicit => Box::new(Engine::<S, NewmarkExplicit>::new(space)?),
+        Integrator::NewmarkImplicit => Box::new(Engine::<S, NewmarkImplicit>::new(space)?),
+        Integrator::Trigonometric => Box::new(Engine::<S, Trigonometric>::new(space)?),
+    })
 }
 
 /// Newmark predictor y1 = y + dt v + dt^2/2 a (exact for the explicit

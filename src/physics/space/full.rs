@@ -16,7 +16,7 @@ use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LdltRef, LltRe
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
-use super::Space;
+use super::{Diagonal, Space};
 use crate::physics::basis::{self, BasisOptions};
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::forces::{linearize, omega_sq_bound_full, SpringForces, SpringScratch, StiffnessPattern};
@@ -279,6 +279,11 @@ impl Space for Full {
 
     fn omega_sq_bound(&self, _loads: &Loads) -> f64 {
         self.omega_sq_bound
+    }
+
+    /// K0 and C couple the DOFs: no diagonal form.
+    fn diagonal<'a>(&'a self, _w: &'a FullWork) -> Option<Diagonal<'a>> {
+        None
     }
 
     fn positions<'w>(&self, _u: &[f64], w: &'w mut FullWork) -> &'w [f64] {

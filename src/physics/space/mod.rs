@@ -53,6 +53,21 @@ impl Default for ForceOptions {
     }
 }
 
+/// The linear part of the equations when it is diagonal, as in the modal
+/// space: h_i(y) = g_i(y) - lambda_i y_i and C = diag(c_i), so that every
+/// coordinate is a damped linear oscillator y_i'' + c_i y_i' + lambda_i y_i = g_i(y)
+/// driven by the rest, g_i = load_i + (a part that depends on y)
+/// (`docs/method.md`, sections 3 and 4).
+#[derive(Clone, Copy, Debug)]
+pub struct Diagonal<'a> {
+    /// lambda_i [1/s^2].
+    pub stiffness: &'a [f64],
+    /// c_i under the current loads [1/s].
+    pub damping: &'a [f64],
+    /// The part of g_i that does not depend on y, under the current loads.
+    pub load: &'a [f64],
+}
+
 /// The equations of one space; see the module documentation.
 pub trait Space: Send + Sized + 'static {
     /// Load terms and scratch of one run.
@@ -106,6 +121,13 @@ pub trait Space: Send + Sized + 'static {
     /// Upper bound on the squared frequencies of the integrated system
     /// under `loads`, in any state where no spring is compressed [1/s^2].
     fn omega_sq_bound(&self, loads: &Loads) -> f64;
+    /// The diagonal linear part of the equations under the loads of the
+    /// last [`Space::apply_loads`], where there is one (the modal space: the
+    /// modes' own springs lambda_i, their Rayleigh damping
+    /// alpha + beta lambda_i and the weighted generalized load); `None` where
+    /// the linear part couples the coordinates (full space). The weights act
+    /// on g alone: g_i = h_i + lambda_i y_i is w_i r_i (`docs/method.md`, section 3).
+    fn diagonal<'a>(&'a self, w: &'a Self::Work) -> Option<Diagonal<'a>>;
 
     /// Slot positions at y, the coordinates of the last [`Space::force`].
     fn positions<'w>(&self, y: &[f64], w: &'w mut Self::Work) -> &'w [f64];
@@ -158,12 +180,12 @@ pub(crate) fn build(scene: Scene, solver: &SolverParams, loads: &Loads, prebuilt
     match solver.reduction {
         Reduction::Modal => match solver.force.evaluation {
             ForceEvaluation::Exact => {
-                Ok(integrator::bind(Modal::<Exact>::new(scene, solver.n_modes, loads, &solver.basis, &solver.force, prebuilt)?, solver.integrator))
+                integrator::bind(Modal::<Exact>::new(scene, solver.n_modes, loads, &solver.basis, &solver.force, prebuilt)?, solver.integrator)
             }
             ForceEvaluation::Cubature => {
-                Ok(integrator::bind(Modal::<Cubature>::new(scene, solver.n_modes, loads, &solver.basis, &solver.force, prebuilt)?, solver.integrator))
+                integrator::bind(Modal::<Cubature>::new(scene, solver.n_modes, loads, &solver.basis, &solver.force, prebuilt)?, solver.integrator)
             }
         },
-        Reduction::Full => Ok(integrator::bind(Full::new(scene, solver.n_modes, loads, &solver.basis)?, solver.integrator)),
+        Reduction::Full => integrator::bind(Full::new(scene, solver.n_modes, loads, &solver.basis)?, solver.integrator),
     }
 }

@@ -26,7 +26,7 @@ mod exact;
 pub use cubature::Cubature;
 pub use exact::Exact;
 
-use super::{ForceOptions, Space};
+use super::{Diagonal, ForceOptions, Space};
 use crate::physics::bake::{SetupData, SpringSet};
 use crate::physics::basis::{self, BasisOptions};
 use crate::physics::error::{PhysicsError, StepFailure};
@@ -167,6 +167,8 @@ pub struct ModalWork<W> {
     damping: Vec<f64>,
     /// Phi^T (M g + f_p): gravity and the point load.
     gravity: Vec<f64>,
+    /// w_i (Phi^T (M g + f_p))_i: the part of w_i r_i that does not depend on q.
+    weighted_load: Vec<f64>,
     /// -(M g + f_p)^T (x* - x_rest): the potential of the loads at q = 0.
     gravity_offset: f64,
     /// What the force model writes.
@@ -277,6 +279,7 @@ impl<F: ReducedForce> Space for Modal<F> {
         ModalWork {
             damping: vec![0.0; r],
             gravity: vec![0.0; r],
+            weighted_load: vec![0.0; r],
             gravity_offset: 0.0,
             force: self.force.work(&self.scene, &self.modes),
             kr: vec![0.0; r * r],
@@ -329,6 +332,9 @@ impl<F: ReducedForce> Space for Modal<F> {
                 let mg = self.scene.dof_mass[k] * loads.gravity[k % d];
                 w.load_scale += ((mg + fi) * (mg + fi) - mg * mg) * self.inv_mass[k];
             }
+        }
+        for ((l, g), wj) in w.weighted_load.iter_mut().zip(&w.gravity).zip(&loads.mode_weights) {
+            *l = wj * g;
         }
     }
 
@@ -401,6 +407,12 @@ impl<F: ReducedForce> Space for Modal<F> {
     /// Weights above 1 scale the stiffness each mode sees beyond its own.
     fn omega_sq_bound(&self, loads: &Loads) -> f64 {
         loads.weight_max() * self.omega_sq_bound
+    }
+
+    /// Phi^T K0 Phi = diag(lambda), Phi^T C Phi = diag(alpha + beta lambda),
+    /// and the weighted generalized load w_i (Phi^T (M g + f_p))_i.
+    fn diagonal<'a>(&'a self, w: &'a Self::Work) -> Option<Diagonal<'a>> {
+        Some(Diagonal { stiffness: &self.modes.basis.lambda, damping: &w.damping, load: &w.weighted_load })
     }
 
     fn positions<'w>(&self, q: &[f64], w: &'w mut Self::Work) -> &'w [f64] {

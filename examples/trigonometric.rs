@@ -1,0 +1,139 @@
+//! The trigonometric scheme measured (docs/method.md, sections 4 and 6):
+//! trajectory error E against a full-space reference at one internal step
+//! per communication step, beside both Newmark schemes at the same
+//! communication step, and the energy of a long undamped run.
+//!
+//! cargo run --release --example trigonometric -- [seconds] [--drift STEPS]
+//!
+//! The reference is the study's: full space, explicit Newmark at 1e-4 s,
+//! checked against its run at half the step. E is that of the study (node
+//! masses are equal and cancel), over the output times of every
+//! communication step from t = 0 to `seconds` (2 s by default).
+
+use std::time::Instant;
+
+use modal_mass_spring::physics::*;
+use modal_mass_spring::scenes;
+
+const REFERENCE_DT: f64 = 1e-4;
+
+struct Run {
+    frames: Vec<Vec<f64>>,
+    run_s: f64,
+    internal_steps: usize,
+}
+
+fn load_static() -> BasisOptions {
+    BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest, anchor_motion: false }
+}
+
+fn solver(reduction: Reduction, integrator: Integrator, n_modes: usize, max_internal_step: f64) -> SolverParams {
+    SolverParams {
+        reduction,
+        integrator,
+        n_modes,
+        max_internal_step,
+        substepping: true,
+        basis: if reduction == Reduction::Modal { load_static() } else { BasisOptions::default() },
+        force: ForceOptions::default(),
+    }
+}
+
+/// Node positions after every communication step `h` (frames every `every` steps), from t = 0 to `seconds`.
+fn simulate(p: &Grid, s: &SolverParams, h: f64, every: usize, seconds: f64) -> Result<Run, PhysicsError> {
+    let mut sim = Simulator::new(p.build()?, s, &Loads::physical(s.n_modes))?;
+    let n = (seconds / h).round() as usize;
+    let mut frames = vec![sim.positions().to_vec()];
+    let mut internal_steps = 0;
+    let t0 = Instant::now();
+    for k in 1..=n {
+        sim.do_step(h)?;
+        internal_steps += sim.internal_steps_last();
+        if k % every == 0 {
+            frames.push(sim.positions().to_vec());
+        }
+    }
+    Ok(Run { frames, run_s: t0.elapsed().as_secs_f64() / seconds, internal_steps: internal_steps / n })
+}
+
+/// E of docs/method.md, section 6 (equal node masses cancel), and the largest node distance error.
+fn error(run: &[Vec<f64>], reference: &[Vec<f64>], d: usize) -> (f64, f64) {
+    let (mut num, mut den, mut max_node) = (0.0, 0.0, 0.0f64);
+    for (x, xr) in run.iter().zip(reference) {
+        for i in 0..x.len() / d {
+            let e2: f64 = (0..d).map(|c| (x[i * d + c] - xr[i * d + c]).powi(2)).sum();
+            num += e2;
+            max_node = max_node.max(e2.sqrt());
+            den += (0..d).map(|c| (xr[i * d + c] - reference[0][i * d + c]).powi(2)).sum::<f64>();
+        }
+    }
+    ((num / den).sqrt(), max_node)
+}
+
+fn compare(scene: &str, h: f64, modes: &[usize], seconds: f64) {
+    let p = scenes::canonical(scene).expect("canonical scene").grid;
+    let d = p.dim;
+    let every_ref = (h / REFERENCE_DT).round() as usize;
+    let full = |dt: f64| solver(Reduction::Full, Integrator::NewmarkExplicit, 0, dt);
+    let reference = simulate(&p, &full(REFERENCE_DT), REFERENCE_DT, every_ref, seconds).expect("reference");
+    let halved = simulate(&p, &full(REFERENCE_DT / 2.0), REFERENCE_DT / 2.0, 2 * every_ref, seconds).expect("reference at half the step");
+    println!(
+        "\n{scene}: communication step {h} s, output every step, {seconds} s; reference E(dt) against E(dt/2) = {:.2e}",
+        error(&reference.frames, &halved.frames, d).0
+    );
+    println!("| modes | integrator | internal steps per step | E | largest node error (m) | run time (s/s) |\n|---|---|---|---|---|---|");
+    for &r in modes {
+        for integrator in [Integrator::Trigonometric, Integrator::NewmarkExplicit, Integrator::NewmarkImplicit] {
+            match simulate(&p, &solver(Reduction::Modal, integrator, r, h), h, 1, seconds) {
+                Ok(run) => {
+                    let (e, node) = error(&run.frames, &reference.frames, d);
+                    println!("| {r} | {} | {} | {e:.4} | {node:.2e} | {:.2e} |", integrator.name(), run.internal_steps, run.run_s);
+                }
+                Err(e) => println!("| {r} | {} | — | failed: {e} | | |", integrator.name()),
+            }
+        }
+    }
+}
+
+/// Energy (kinetic + potential) of an undamped run of `steps` communication
+/// steps: its largest distance from the start, relative to the largest
+/// kinetic energy, over the first and the last tenth of the run.
+fn drift(scene: &str, r: usize, h: f64, steps: usize) {
+    let p = scenes::canonical(scene).expect("canonical scene").grid;
+    let s = solver(Reduction::Modal, Integrator::Trigonometric, r, h);
+    let mut sim = Simulator::new(p.build().unwrap(), &s, &Loads::physical(r)).unwrap();
+    let e0 = sim.kinetic_energy() + sim.potential_energy();
+    let (mut k_max, mut first, mut last, mut all) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for k in 0..steps {
+        sim.do_step(h).unwrap();
+        let kinetic = sim.kinetic_energy();
+        let e = kinetic + sim.potential_energy();
+        k_max = k_max.max(kinetic);
+        let dev = (e - e0).abs();
+        all = all.max(dev);
+        if k < steps / 10 {
+            first = first.max(dev);
+        }
+        if k >= steps - steps / 10 {
+            last = last.max(dev);
+        }
+    }
+    println!(
+        "\n{scene}, {r} modes (load + static correction), trigonometric, undamped, {steps} steps of {h} s ({} s): largest kinetic energy {k_max:.4e} J; \
+         largest |E(t) - E(0)| / that: {:.3e} over the first tenth, {:.3e} over the last tenth, {:.3e} over the run",
+        steps as f64 * h,
+        first / k_max,
+        last / k_max,
+        all / k_max
+    );
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let seconds: f64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(2.0);
+    let drift_steps: usize = args.iter().position(|a| a == "--drift").and_then(|i| args.get(i + 1)).and_then(|s| s.parse().ok()).unwrap_or(10_000);
+    compare("paper-2d-top-row", 0.02, &[16], seconds);
+    compare("paper-3d-sheet", 0.05, &[8, 16], seconds);
+    drift("paper-2d-top-row", 16, 0.02, drift_steps);
+    drift("paper-3d-sheet", 16, 0.05, drift_steps);
+}
