@@ -59,6 +59,8 @@ METRICS = [
     "maxForceResidual",  # over the output points
     "lowestFrequency",  # rad/s, modeFrequencies[0]
     "outputPoints",  # communication points after the start
+    "E",  # error against the reference run (--reference), docs/method.md section 6; NaN without one
+    "maxNodeError",  # m, the largest node distance from the reference over the output points
     "message",  # the FMU's warnings and errors, or the exception of a refused run
 ]
 # Columns that differ from one execution of the same run to the next: left
@@ -177,9 +179,12 @@ def fmpy_start_value(var, value):
     return value
 
 
-def run_one(fmu_data, digest, point, stop_time, step):
+def run_one(fmu_data, digest, point, stop_time, step, keep_positions=False):
     """Simulate one point of the grid with fmpy.simulate_fmu; returns its row
-    (the point's values, then METRICS and NONDETERMINISTIC)."""
+    (the point's values, then METRICS and NONDETERMINISTIC). With
+    `keep_positions` the row also holds the node positions at every output
+    point (`_positions`) and before the first step (`_start`), for the error
+    against a reference; they are not written out."""
     from fmpy import read_model_description, simulate_fmu
     from fmpy.fmi1 import FMICallException
     from fmpy.fmi3 import FMU3Slave
@@ -212,6 +217,8 @@ def run_one(fmu_data, digest, point, stop_time, step):
                 state.update(n=nx * ny * dim, nx=nx, dim=dim, rest=-(ny - 1) * fmu.getFloat64([vr["spacing"]])[0], sags=[])
                 state["omega0"] = fmu.getFloat64([vr["modeFrequencies"]], nValues=int(fmu.getUInt64([vr["nModes"]])[0]))[0]
             x = np.asarray(fmu.getFloat64([vr["positions"]], nValues=state["n"]))
+            if keep_positions:
+                state.setdefault("frames", []).append(x)
             bottom_y = x[-state["nx"] * state["dim"] :][1 :: state["dim"]]
             state["sags"].append(state["rest"] - bottom_y.mean())
             return True
@@ -228,6 +235,10 @@ def run_one(fmu_data, digest, point, stop_time, step):
             fmu_instance=fmu,
         )
         sags = np.array(state["sags"])
+        if keep_positions:
+            row["_positions"] = np.array(state["frames"])
+            row["_start"] = start_positions(unzipdir, md, start_values)
+            row["_dim"] = state["dim"]
         row.update(
             finalTime=float(res["time"][-1]),
             finalSag=float(sags[-1]),
@@ -256,6 +267,40 @@ def run_one(fmu_data, digest, point, stop_time, step):
     return row
 
 
+def start_positions(unzipdir, md, start_values):
+    """The node positions a run with these start values begins at: read from
+    a fresh instance right after initialization."""
+    from fmpy.fmi3 import FMU3Slave
+    from fmpy.simulation import apply_start_values
+
+    fmu = FMU3Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier, instanceName="start")
+    fmu.instantiate()
+    try:
+        apply_start_values(fmu, md, dict(start_values))
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        vr = {v.name: v.valueReference for v in md.modelVariables}
+        nx, ny, dim = (int(x) for x in fmu.getUInt64([vr["nx"], vr["ny"], vr["dimension"]]))
+        return np.asarray(fmu.getFloat64([vr["positions"]], nValues=nx * ny * dim))
+    finally:
+        fmu.freeInstance()
+
+
+def error_against(row, ref):
+    """E of docs/method.md section 6 (every node has the same mass) and the
+    largest node distance, of a run's positions against the reference's at
+    the same output points; NaN where the run did not complete or its output
+    points differ."""
+    x, r = row.get("_positions"), ref.get("_positions")
+    if x is None or r is None or x.shape != r.shape:
+        return math.nan, math.nan
+    dim = ref["_dim"]
+    diff = (x - r).reshape(len(x), -1, dim)
+    motion = (r - ref["_start"]).reshape(len(r), -1, dim)
+    e = math.sqrt(float((diff**2).sum())) / math.sqrt(float((motion**2).sum()))
+    return e, float(np.sqrt((diff**2).sum(axis=2)).max())
+
+
 # -- the sweep -----------------------------------------------------------------
 
 
@@ -269,9 +314,12 @@ def experiment(md, stop_time=None, step=None):
     return stop_time, step
 
 
-def run_sweep(fmu, axes, stop_time=None, step=None, client=None, progress=True):
+def run_sweep(fmu, axes, stop_time=None, step=None, client=None, progress=True, reference=None):
     """The rows of every point of the grid, in grid order. `client`: a
-    dask.distributed Client to run them on; None runs them here, serially."""
+    dask.distributed Client to run them on; None runs them here, serially.
+    `reference`: start values of a reference run (e.g. full space at a short
+    step), run beside the grid; every row then gets E and maxNodeError
+    against it, and the reference's own row comes last, with `run` = "reference"."""
     from fmpy import read_model_description
 
     stop_time, step = experiment(read_model_description(fmu), stop_time, step)
@@ -279,16 +327,30 @@ def run_sweep(fmu, axes, stop_time=None, step=None, client=None, progress=True):
         data = f.read()
     digest = fmu_digest(data)
     points = grid_points(axes)
+    keep = reference is not None
+    if keep:
+        points = points + [dict(reference)]
     if client is None:
         rows = []
         for i, point in enumerate(points):
-            rows.append(run_one(data, digest, point, stop_time, step))
+            rows.append(run_one(data, digest, point, stop_time, step, keep))
             if progress:
                 serial_progress(i + 1, len(points))
     else:
-        rows = run_on_cluster(client, data, digest, points, stop_time, step, progress)
+        rows = run_on_cluster(client, data, digest, points, stop_time, step, progress, keep)
+    if keep:
+        ref = rows[-1]
+        for row in rows:
+            row["E"], row["maxNodeError"] = error_against(row, ref)
+        for row in rows:
+            for k in [k for k in row if k.startswith("_")]:
+                del row[k]
     for i, row in enumerate(rows):
         row["run"] = i
+    if keep:
+        rows[-1]["run"] = "reference"
+        for name, _ in axes:
+            rows[-1].setdefault(name, "")
     return rows
 
 
@@ -301,7 +363,7 @@ def serial_progress(done, total, width=40):
         print(f"{done}/{total} runs", flush=True)
 
 
-def run_on_cluster(client, data, digest, points, stop_time, step, progress):
+def run_on_cluster(client, data, digest, points, stop_time, step, progress, keep_positions=False):
     import cloudpickle
     from distributed import progress as progress_bar
     from distributed import wait
@@ -312,7 +374,7 @@ def run_on_cluster(client, data, digest, points, stop_time, step, progress):
     if module.__name__ != "__main__":
         cloudpickle.register_pickle_by_value(module)
     fmu_data = client.scatter(data, broadcast=True)
-    futures = [client.submit(run_one, fmu_data, digest, p, stop_time, step, pure=False) for p in points]
+    futures = [client.submit(run_one, fmu_data, digest, p, stop_time, step, keep_positions, pure=False) for p in points]
     if progress:
         progress_bar(futures)
         print()
@@ -430,6 +492,27 @@ def plot(path, rows, axes, title):
     plt.close(fig)
 
 
+def plot_error(path, rows, title):
+    """Error against run time: E of every completed run against its wall time."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    done = [r for r in rows if r["run"] != "reference" and not math.isnan(r["E"]) and r["E"] > 0]
+    fig, ax = plt.subplots(figsize=(7, 5))
+    ax.loglog([r["wallTime"] for r in done], [r["E"] for r in done], "o")
+    for r in done:
+        ax.annotate(str(r["run"]), (r["wallTime"], r["E"]), fontsize=7, xytext=(3, 3), textcoords="offset points")
+    ax.set_xlabel("wall time of the run [s]")
+    ax.set_ylabel("E against the reference")
+    ax.grid(alpha=0.3, which="both")
+    ax.set_title(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
 # -- command line ---------------------------------------------------------------
 
 
@@ -444,6 +527,14 @@ def main(argv=None):
     where.add_argument("--workers", type=int, default=None, help="processes of the LocalCluster (default: the number of cores)")
     where.add_argument("--scheduler", metavar="ADDRESS", help="the scheduler of a running cluster, e.g. tcp://10.0.0.5:8786")
     where.add_argument("--serial", action="store_true", help="run in this process, one run after the other, without Dask")
+    p.add_argument(
+        "--reference",
+        action="append",
+        default=None,
+        metavar="NAME=VALUE",
+        help="start value of a reference run (repeatable, e.g. --reference reduction=full --reference maxInternalStep=1e-4): "
+        "every run gets E and maxNodeError against it (docs/method.md section 6), and the plot shows E against run time",
+    )
     p.add_argument("--no-plot", action="store_true")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     a = p.parse_args(argv)
@@ -455,12 +546,18 @@ def main(argv=None):
         axes = parse_grid(md, a.param)
     except ValueError as e:
         p.error(str(e))
+    reference = None
+    if a.reference is not None:
+        try:
+            reference = {name: values[0] for name, values in parse_grid(md, a.reference)}
+        except ValueError as e:
+            p.error(str(e))
     n = len(grid_points(axes))
     grid = " x ".join(f"{name} ({len(v)})" for name, v in axes) or "the FMU's start values"
     t0 = time.perf_counter()
     if a.serial:
         print(f"sweep: {n} runs of {grid}, serially")
-        rows = run_sweep(a.fmu, axes, a.stop_time, a.step, progress=not a.quiet)
+        rows = run_sweep(a.fmu, axes, a.stop_time, a.step, progress=not a.quiet, reference=reference)
     else:
         from distributed import Client, LocalCluster
 
@@ -475,7 +572,7 @@ def main(argv=None):
         print(f"sweep: {n} runs of {grid} on {where}")
         t0 = time.perf_counter()
         try:
-            rows = run_sweep(a.fmu, axes, a.stop_time, a.step, client=client, progress=not a.quiet)
+            rows = run_sweep(a.fmu, axes, a.stop_time, a.step, client=client, progress=not a.quiet, reference=reference)
         finally:
             client.close()
             if cluster is not None:
@@ -492,8 +589,13 @@ def main(argv=None):
         stop, step = experiment(md, a.stop_time, a.step)
         fixed = [f"{name}={cell(v[0])}" for name, v in axes if len(v) == 1]
         setting = ", ".join(fixed + [f"stop time {stop:g} s"] + ([] if STEP in dict(axes) else [f"step {step:g} s"]))
-        plot(stem + ".png", rows, axes, f"{md.modelName}: {os.path.basename(a.fmu)}, {n} runs; {setting}")
+        grid_rows = rows[:-1] if reference is not None else rows
+        plot(stem + ".png", grid_rows, axes, f"{md.modelName}: {os.path.basename(a.fmu)}, {n} runs; {setting}")
         written.append(stem + ".png")
+        if reference is not None:
+            ref = ", ".join(f"{k}={cell(v)}" for k, v in reference.items())
+            plot_error(stem + "-error.png", rows, f"error against run time; reference {ref}; {setting}")
+            written.append(stem + "-error.png")
     counts = {}
     for r in rows:
         counts[r["status"]] = counts.get(r["status"], 0) + 1

@@ -163,3 +163,22 @@ def test_documented_sweeps_parse(md):
         params = [args[i + 1] for i, a in enumerate(args) if a == "--param"]
         assert params, command
         assert sweep.parse_grid(md, params)
+        references = [args[i + 1] for i, a in enumerate(args) if a == "--reference"]
+        assert all(len(values) == 1 for _, values in sweep.parse_grid(md, references))
+
+
+def test_error_against_a_reference_run(default_fmu, md, client):
+    """With a reference run (full space, short internal steps) every run gets
+    E of docs/method.md section 6 against it: 0 for the reference itself,
+    falling as modes are added, and the same numbers on the cluster as
+    serially (the study's independent runs, spread over workers)."""
+    axes = sweep.parse_grid(md, ["nModes=2,8,32"])
+    reference = {name: values[0] for name, values in sweep.parse_grid(md, ["reduction=full", "maxInternalStep=1e-4"])}
+    serial = sweep.run_sweep(default_fmu, axes, stop_time=0.5, progress=False, reference=reference)
+    on_cluster = sweep.run_sweep(default_fmu, axes, stop_time=0.5, client=client, progress=False, reference=reference)
+    assert deterministic(on_cluster) == deterministic(serial)
+    ref = serial[-1]
+    assert ref["run"] == "reference" and ref["E"] == 0.0 and ref["maxNodeError"] == 0.0
+    errors = [r["E"] for r in serial[:-1]]
+    print("E against full space at 1e-4 s, nModes = 2, 8, 32:", errors)
+    assert all(np.isfinite(errors)) and errors[0] > errors[1] > errors[2] > 0.0
