@@ -3,6 +3,9 @@
 //!
 //! cargo run --release --example error_vs_runtime -- [scene] [seconds]
 
+mod common;
+
+use common::error;
 use std::time::Instant;
 
 use modal_mass_spring::physics::*;
@@ -27,21 +30,6 @@ fn simulate(p: &Grid, s: &SolverParams, h: f64, frame_every: usize, frames: usiz
         out.push(sim.positions().to_vec());
     }
     Ok(Run { frames: out, setup_s, run_s: t1.elapsed().as_secs_f64() })
-}
-
-/// E = sqrt(sum_k sum_i m_i |x_i - x_ref,i|^2) / sqrt(sum_k sum_i m_i |x_ref,i - x_i(0)|^2);
-/// all nodes weigh the same here, so m_i cancels. Also the largest node distance error.
-fn error(run: &[Vec<f64>], reference: &[Vec<f64>], d: usize) -> (f64, f64) {
-    let (mut num, mut den, mut max_node) = (0.0, 0.0, 0.0f64);
-    for (x, xr) in run.iter().zip(reference) {
-        for i in 0..x.len() / d {
-            let e2: f64 = (0..d).map(|c| (x[i * d + c] - xr[i * d + c]).powi(2)).sum();
-            num += e2;
-            max_node = max_node.max(e2.sqrt());
-            den += (0..d).map(|c| (xr[i * d + c] - reference[0][i * d + c]).powi(2)).sum::<f64>();
-        }
-    }
-    ((num / den).sqrt(), max_node)
 }
 
 fn main() {

@@ -10,6 +10,9 @@
 //! masses are equal and cancel), over the output times of every
 //! communication step from t = 0 to `seconds` (2 s by default).
 
+mod common;
+
+use common::error;
 use std::time::Instant;
 
 use modal_mass_spring::physics::*;
@@ -54,20 +57,6 @@ fn simulate(p: &Grid, s: &SolverParams, h: f64, every: usize, seconds: f64) -> R
         }
     }
     Ok(Run { frames, run_s: t0.elapsed().as_secs_f64() / seconds, internal_steps: internal_steps / n })
-}
-
-/// E of docs/method.md, section 6 (equal node masses cancel), and the largest node distance error.
-fn error(run: &[Vec<f64>], reference: &[Vec<f64>], d: usize) -> (f64, f64) {
-    let (mut num, mut den, mut max_node) = (0.0, 0.0, 0.0f64);
-    for (x, xr) in run.iter().zip(reference) {
-        for i in 0..x.len() / d {
-            let e2: f64 = (0..d).map(|c| (x[i * d + c] - xr[i * d + c]).powi(2)).sum();
-            num += e2;
-            max_node = max_node.max(e2.sqrt());
-            den += (0..d).map(|c| (xr[i * d + c] - reference[0][i * d + c]).powi(2)).sum::<f64>();
-        }
-    }
-    ((num / den).sqrt(), max_node)
 }
 
 fn compare(scene: &str, h: f64, modes: &[usize], seconds: f64) {

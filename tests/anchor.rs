@@ -306,12 +306,6 @@ fn a_moving_anchor_is_a_load_pattern() {
     assert!(errors[1] < 0.2 * errors[0], "anchorMotion does not help: {errors:?}");
 }
 
-fn refused(f: &Fmu, status: fmi_sys::fmi3::fmi3Status, needle: &str) {
-    let last = f.messages().last().cloned().unwrap_or_default();
-    assert!(last.contains(needle), "{needle:?} not in {last:?}");
-    f.expect_error(status, needle);
-}
-
 #[test]
 fn fmi_anchor_inputs_refuse_non_finite_values_and_keep_the_state() {
     let f = Fmu::started();
@@ -320,7 +314,7 @@ fn fmi_anchor_inputs_refuse_non_finite_values_and_keep_the_state() {
     let before = f.outputs();
     let state = f.snapshot();
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 2e6] {
-        refused(&f, f.set_f64(vr::ANCHOR_Y, &[bad]), "anchorY = ");
+        f.refused(f.set_f64(vr::ANCHOR_Y, &[bad]), "anchorY = ");
         assert_eq!(f.f64s(vr::ANCHOR_Y, 1), vec![0.0]);
     }
     assert_eq!(f.outputs(), before, "outputs unchanged");

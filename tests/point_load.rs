@@ -7,7 +7,6 @@
 mod common;
 
 use common::*;
-use fmi_sys::fmi3::fmi3Status;
 use modal_mass_spring::fmi::variables::vr;
 use modal_mass_spring::physics::*;
 use modal_mass_spring::scenes;
@@ -181,12 +180,6 @@ fn the_point_load_alone_is_a_load_pattern() {
 // ---- through the C ABI ----
 
 /// `status` is fmi3Error with a logged message that contains `needle`.
-fn refused(f: &Fmu, status: fmi3Status, needle: &str) {
-    let last = f.messages().last().cloned().unwrap_or_default();
-    assert!(last.contains(needle), "{needle:?} not in {last:?}");
-    f.expect_error(status, needle);
-}
-
 #[test]
 fn fmi_the_point_load_is_an_input_settable_in_step_mode() {
     let f = Fmu::new();
@@ -219,7 +212,7 @@ fn fmi_non_finite_loads_are_refused_and_the_state_kept() {
     let before = f.outputs();
     let state = f.snapshot();
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-        refused(&f, f.set_f64(vr::LOAD_X, &[bad]), "loadX = ");
+        f.refused(f.set_f64(vr::LOAD_X, &[bad]), "loadX = ");
         assert_eq!(f.f64s(vr::LOAD_X, 1), vec![0.0]);
     }
     assert_eq!(f.outputs(), before, "outputs unchanged");
@@ -230,9 +223,9 @@ fn fmi_non_finite_loads_are_refused_and_the_state_kept() {
 #[test]
 fn fmi_the_load_node_must_be_a_free_node_of_the_grid() {
     let f = Fmu::new();
-    refused(&f, f.set_u64(vr::LOAD_ROW, 10), "loadRow = 10, loadColumn = 5 is outside the grid of ny = 10 rows");
-    refused(&f, f.set_u64(vr::LOAD_COLUMN, 10), "outside the grid");
-    refused(&f, f.set_u64(vr::LOAD_ROW, 9), "loadRow = 9, loadColumn = 5 is a held node (fixedNodes = top-row)");
+    f.refused(f.set_u64(vr::LOAD_ROW, 10), "loadRow = 10, loadColumn = 5 is outside the grid of ny = 10 rows");
+    f.refused(f.set_u64(vr::LOAD_COLUMN, 10), "outside the grid");
+    f.refused(f.set_u64(vr::LOAD_ROW, 9), "loadRow = 9, loadColumn = 5 is a held node (fixedNodes = top-row)");
     assert_eq!(f.get_u64(vr::LOAD_ROW), 0, "refused values are not stored");
     assert_eq!(f.get_u64(vr::LOAD_COLUMN), 5);
     // Growing the grid first lets a farther node be chosen; nx, ny and loadRow in one call too.
@@ -245,7 +238,7 @@ fn fmi_the_load_node_must_be_a_free_node_of_the_grid() {
     let g = Fmu::new();
     assert_eq!(g.set_i64(vr::FIXED_NODES, 2), OK);
     assert_eq!(g.set_u64(vr::LOAD_ROW, 9), OK, "{:?}", g.messages());
-    refused(&g, g.set_u64(vr::LOAD_COLUMN, 0), "is a held node");
+    g.refused(g.set_u64(vr::LOAD_COLUMN, 0), "is a held node");
 }
 
 /// The default load node is the middle of the bottom row of any grid:

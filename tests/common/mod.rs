@@ -102,6 +102,13 @@ impl Fmu {
         self.log.0.lock().unwrap().iter().map(|(_, c, m)| format!("[{c}] {m}")).collect()
     }
 
+    /// `status` is fmi3Error and the last message logged names `needle` (the log is then cleared).
+    pub fn refused(&self, status: fmi3Status, needle: &str) {
+        let last = self.messages().last().cloned().unwrap_or_default();
+        assert!(last.contains(needle), "{needle:?} not in {last:?}");
+        self.expect_error(status, needle);
+    }
+
     /// `status` is fmi3Error and an error was logged (the log is then cleared).
     pub fn expect_error(&self, status: fmi3Status, what: &str) {
         assert_eq!(status, ERROR, "{what}");
