@@ -1,7 +1,7 @@
 """Plots of the error-against-run-time study, one figure per scene: error
 against run time (log-log; full space in black, modal runs coloured by
 variant, marker by integrator), error against the number of modes (explicit
-runs at the shortest and longest step, coloured by variant) and error against
+and trigonometric runs at the shortest and longest step, coloured by variant) and error against
 the largest forceResidual of each modal run (coloured by variant; Spearman's
 rank correlation in the title). force_residual.png: E against the largest and
 the mean forceResidual of the leave-out runs of every scene."""
@@ -23,7 +23,7 @@ VARIANTS = ["paper", "load", "load+static", "load+static@equilibrium", "load+cub
             "load+static+cubature", "load+static@equilibrium+cubature"]
 PALETTE = plt.get_cmap("tab10").colors
 COLOUR = {v: PALETTE[i % len(PALETTE)] for i, v in enumerate(VARIANTS)}
-MARKER = {"newmark-explicit": "o", "newmark-implicit": "^"}
+MARKER = {"newmark-explicit": "o", "newmark-implicit": "^", "trigonometric": "D"}
 
 
 def variant(r):
@@ -85,15 +85,19 @@ for scene, rs in by_scene.items():
         a.loglog([f(p, "run_s_per_sim_s") for p in pts], [f(p, "error") for p in pts], marker, color=colour(v),
                  label=f"{v} {integ.replace('newmark-', '')}", alpha=0.75, markersize=5,
                  markerfacecolor="none" if integ == "newmark-implicit" else colour(v))
-    modal = [r for r in rs if r["method"] == "modal" and r["integrator"] == "newmark-explicit"]
+    modal = [r for r in rs if r["method"] == "modal" and r["integrator"] in ("newmark-explicit", "trigonometric")]
     steps = sorted({r["step_label"] for r in modal}, key=lambda s: float(s.split("/")[1]) if "/" in s else 0)
     shown = [steps[-1], steps[0]] if len(steps) > 1 else steps
     for v in [v for v in VARIANTS if any(variant(r) == v for r in modal)] + sorted({variant(r) for r in modal} - set(VARIANTS)):
         for k, step in enumerate(shown):
-            sp = sorted((p for p in modal if variant(p) == v and p["step_label"] == step), key=lambda p: int(p["modes"]))
-            if sp:
-                b.loglog([int(p["modes"]) for p in sp], [f(p, "error") for p in sp], "o-" if k == 0 else "s--", color=colour(v),
-                         label=f"{v} step {step}", alpha=0.8, markersize=4)
+            for integ in ("newmark-explicit", "trigonometric"):
+                sp = sorted((p for p in modal if variant(p) == v and p["step_label"] == step and p["integrator"] == integ),
+                            key=lambda p: int(p["modes"]))
+                if sp:
+                    trig = integ == "trigonometric"
+                    b.loglog([int(p["modes"]) for p in sp], [f(p, "error") for p in sp],
+                             ("D" if trig else "o" if k == 0 else "s") + (":" if trig else "-" if k == 0 else "--"), color=colour(v),
+                             label=f"{v} {integ.replace('newmark-', '')} step {step}", alpha=0.8, markersize=4)
     fr = [r for r in rs if leaves_out(r) and np.isfinite(f(r, "force_residual_max"))]
     for v in sorted({variant(r) for r in fr}, key=lambda v: order.get(v, 99)):
         pts = [r for r in fr if variant(r) == v and f(r, "force_residual_max") > 0]
@@ -105,7 +109,7 @@ for scene, rs in by_scene.items():
     a.legend(fontsize=6, ncol=2)
     b.set_xlabel("modes kept r")
     b.set_ylabel("trajectory error E")
-    b.set_title(f"{scene}: error against modes (explicit)")
+    b.set_title(f"{scene}: error against modes (explicit, trigonometric)")
     b.legend(fontsize=6, ncol=2)
     c.set_xlabel("largest forceResidual over the run")
     c.set_ylabel("trajectory error E (resolved window)")
