@@ -269,7 +269,8 @@ impl fmt::Display for PhysicsError {
             CubatureNotReached { tolerance, reached, springs } => write!(
                 f,
                 "the cubature reached a relative force error of {reached:.3e} with {springs} springs, its limit (at most 1000 and half \
-                 the springs), or the fit stopped improving; the tolerance {tolerance:e} needs exact forces"
+                 the springs), or the fit stopped improving, short of half the tolerance {tolerance:e} (the training's margin); \
+                 that tolerance needs exact forces"
             ),
             CubatureTooManyModes { modes, limit } => {
                 write!(f, "a cubature is trained for at most {limit} modes, {modes} are kept; keep fewer modes or use exact forces")
