@@ -196,7 +196,16 @@ fn run(prep: &mut Prepared, h: f64, seconds: f64, budget_s: f64, repeats: usize)
         }
     }
     let (frames, internal_steps, force_residual_max, force_residual_mean) = last.unwrap();
-    Ok(Trajectory { frames, setup_s: prep.setup_s, run_s, step_s, internal_steps, force_residual_max, force_residual_mean, springs_visited: springs_visited(sim) })
+    Ok(Trajectory {
+        frames,
+        setup_s: prep.setup_s,
+        run_s,
+        step_s,
+        internal_steps,
+        force_residual_max,
+        force_residual_mean,
+        springs_visited: springs_visited(sim),
+    })
 }
 
 /// Sets up and runs.

@@ -373,7 +373,10 @@ def run_on_cluster(client, data, digest, points, stop_time, step, progress, keep
     module = sys.modules[__name__]
     if module.__name__ != "__main__":
         cloudpickle.register_pickle_by_value(module)
-    fmu_data = client.scatter(data, broadcast=True)
+    # A key of its own (hash=False): a content-hashed key would be shared by
+    # every sweep of the same FMU on this client, and this sweep's cancel at
+    # the end could then drop the data a following sweep has just scattered.
+    fmu_data = client.scatter(data, broadcast=True, hash=False)
     futures = [client.submit(run_one, fmu_data, digest, p, stop_time, step, keep_positions, pure=False) for p in points]
     if progress:
         progress_bar(futures)
