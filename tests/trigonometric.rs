@@ -9,7 +9,6 @@
 mod common;
 
 use common::*;
-use modal_mass_spring::fmi::exports::fmi3SetFMUState;
 use modal_mass_spring::fmi::variables::vr;
 use modal_mass_spring::physics::engine::{Engine, Stepper};
 use modal_mass_spring::physics::error::StepFailure;
@@ -616,9 +615,7 @@ fn trigonometric_fmu() -> Fmu {
 fn fmi_state_resumes_bit_for_bit() {
     let f = trigonometric_fmu();
     f.run(10, 0.02);
-    let st = f.get_state();
-    let bytes = f.serialize(st);
-    let continue_run = |f: &Fmu| {
+    f.assert_resumes(|f: &Fmu| {
         let mut out = Vec::new();
         for k in 0..30 {
             assert_eq!(f.set_f64(vr::ANCHOR_X, &[0.01 * (0.3 * k as f64).sin()]), OK);
@@ -630,16 +627,7 @@ fn fmi_state_resumes_bit_for_bit() {
             out.extend(f.outputs());
         }
         out
-    };
-    let first = continue_run(&f);
-    assert_eq!(unsafe { fmi3SetFMUState(f.inst, st) }, OK);
-    assert_eq!(continue_run(&f), first, "get/set");
-    let (status, st2) = f.deserialize(&bytes);
-    assert_eq!(status, OK);
-    assert_eq!(unsafe { fmi3SetFMUState(f.inst, st2) }, OK);
-    assert_eq!(continue_run(&f), first, "serialize/deserialize");
-    f.free_state(st);
-    f.free_state(st2);
+    });
 }
 
 /// In full space the stiffness and the damping couple every DOF: the

@@ -232,6 +232,24 @@ impl Fmu {
         let s = unsafe { fmi3DeserializeFMUState(self.inst, b.as_ptr(), b.len(), &mut st) };
         (s, st)
     }
+
+    /// Takes the FMU state now, runs `continue_run` from it, then restores
+    /// it by fmi3SetFMUState and through serialization: each continuation
+    /// must return the same values as the first.
+    #[allow(dead_code)]
+    pub fn assert_resumes(&self, continue_run: impl Fn(&Fmu) -> Vec<u64>) {
+        let st = self.get_state();
+        let bytes = self.serialize(st);
+        let first = continue_run(self);
+        assert_eq!(unsafe { fmi3SetFMUState(self.inst, st) }, OK);
+        assert_eq!(continue_run(self), first, "get/set");
+        let (status, st2) = self.deserialize(&bytes);
+        assert_eq!(status, OK);
+        assert_eq!(unsafe { fmi3SetFMUState(self.inst, st2) }, OK);
+        assert_eq!(continue_run(self), first, "serialize/deserialize");
+        self.free_state(st);
+        self.free_state(st2);
+    }
 }
 
 impl Drop for Fmu {
