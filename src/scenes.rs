@@ -4,24 +4,24 @@
 
 use crate::fmi::model::Params;
 use crate::fmi::variables::{scene_names, vr};
-use crate::physics::{Grid, Loads, PhysicsError, Simulator, SolverParams};
+use crate::physics::{Grid, Loads, PhysicsError, Settings, Simulator};
 
 /// Grid, solver and loads of one set-up.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Setup {
     pub grid: Grid,
-    pub solver: SolverParams,
+    pub solver: Settings,
     pub loads: Loads,
 }
 
 impl Setup {
     /// The set-up of the FMU with these variable values.
     pub fn from_params(p: &Params) -> Self {
-        Setup { grid: p.grid(), solver: p.solver(), loads: p.loads() }
+        Setup { grid: p.grid(), solver: p.settings(), loads: p.loads() }
     }
 
     /// The same set-up with `solver`, and loads sized to its modes (every weight 1).
-    pub fn with_solver(&self, solver: SolverParams) -> Self {
+    pub fn with_settings(&self, solver: Settings) -> Self {
         let loads = Loads { mode_weights: vec![1.0; solver.n_modes], ..self.loads.clone() };
         Setup { grid: self.grid.clone(), solver, loads }
     }

@@ -13,16 +13,16 @@ use modal_mass_spring::physics::*;
 use modal_mass_spring::scenes::{self, Setup};
 
 /// The paper's 2D scene on a `columns` x `rows` grid with `solver`.
-fn small(columns: usize, rows: usize, solver: SolverParams) -> Setup {
+fn small(columns: usize, rows: usize, solver: Settings) -> Setup {
     let mut setup = scenes::canonical("paper-2d-top-row").unwrap();
     setup.grid.columns = columns;
     setup.grid.rows = rows;
     setup.loads.load_node = None;
-    setup.with_solver(solver)
+    setup.with_settings(solver)
 }
 
-fn full(max_internal_step: f64) -> SolverParams {
-    let mut s = SolverParams::new(Reduction::Full, Integrator::NewmarkExplicit, 0);
+fn full(max_internal_step: f64) -> Settings {
+    let mut s = Settings::new(Reduction::Full, Integrator::NewmarkExplicit, 0);
     s.max_internal_step = max_internal_step;
     s
 }
@@ -169,7 +169,7 @@ fn equivalence_principle() {
     for (label, solver) in [
         ("full space", full(1e-3)),
         ("modal, 12 lowest modes", {
-            let mut s = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 12);
+            let mut s = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 12);
             s.max_internal_step = 1e-3;
             s
         }),
@@ -177,7 +177,7 @@ fn equivalence_principle() {
         let mut errors = Vec::new();
         for h in [0.02, 0.01, 0.005] {
             let steps = (1.0 / h) as usize;
-            let setup = scenes::canonical("paper-2d-top-row").unwrap().with_solver(solver.clone());
+            let setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver.clone());
             let mut moving = setup.simulator().unwrap();
             let parabola = |t: f64| [0.5 * accel[0] * t * t, 0.5 * accel[1] * t * t, 0.0];
             let got = drive(&mut moving, steps, h, parabola);
@@ -205,9 +205,9 @@ fn equivalence_principle() {
 #[test]
 fn every_mode_matches_the_full_space_with_anchor_motion_and_a_load() {
     let run = |reduction| {
-        let mut solver = SolverParams::new(reduction, Integrator::NewmarkExplicit, if reduction == Reduction::Modal { 180 } else { 0 });
+        let mut solver = Settings::new(reduction, Integrator::NewmarkExplicit, if reduction == Reduction::Modal { 180 } else { 0 });
         solver.max_internal_step = 2e-4;
-        let setup = scenes::canonical("paper-2d-top-row").unwrap().with_solver(solver);
+        let setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
         let mut sim = setup.simulator().unwrap();
         assert!(sim.max_stable_step() == 2e-4);
         let mut trace = Vec::new();
@@ -238,9 +238,9 @@ fn every_mode_matches_the_full_space_with_anchor_motion_and_a_load() {
 /// anchor moving as `A sin(omega t)` along x, from the still sheet without
 /// gravity (a linear response) and without damping.
 fn response(weights: &[f64], j: usize, omega: f64, seconds: f64) -> f64 {
-    let mut solver = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, weights.len());
+    let mut solver = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, weights.len());
     solver.max_internal_step = 1e-3;
-    let mut setup = scenes::canonical("paper-2d-top-row").unwrap().with_solver(solver);
+    let mut setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
     setup.loads.gravity = [0.0; 3];
     setup.loads.mode_weights = weights.to_vec();
     let mut sim = setup.simulator().unwrap();
@@ -262,8 +262,8 @@ fn response(weights: &[f64], j: usize, omega: f64, seconds: f64) -> f64 {
 #[test]
 fn harmonic_anchor_motion_resonates_in_its_mode_and_not_in_a_deleted_one() {
     let r = 4;
-    let solver = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, r);
-    let setup = scenes::canonical("paper-2d-top-row").unwrap().with_solver(solver);
+    let solver = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, r);
+    let setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
     let sim = setup.simulator().unwrap();
     let omegas = sim.mode_frequencies().to_vec();
     // The lowest mode is the sheet swinging sideways: an anchor moving along x drives it.
@@ -292,13 +292,15 @@ fn a_moving_anchor_is_a_load_pattern() {
     let mut reference_solver = full(1e-3);
     reference_solver.max_internal_step = 1e-3;
     let setup = scenes::canonical("paper-2d-top-row").unwrap();
-    let want = drive(&mut setup.with_solver(reference_solver).simulator().unwrap(), steps, h, path);
+    let want = drive(&mut setup.with_settings(reference_solver).simulator().unwrap(), steps, h, path);
     let mut errors = Vec::new();
     for anchor_motion in [false, true] {
-        let mut solver = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 8);
+        let mut solver = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 8);
         solver.max_internal_step = 1e-3;
-        solver.basis = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest, anchor_motion };
-        let got = drive(&mut setup.with_solver(solver).simulator().unwrap(), steps, h, path);
+        solver.mode_selection = ModeSelection::Load;
+        solver.static_correction = true;
+        solver.anchor_motion = anchor_motion;
+        let got = drive(&mut setup.with_settings(solver).simulator().unwrap(), steps, h, path);
         let err = max_diff(&got, &want);
         println!("8 load modes + static correction, anchorMotion = {anchor_motion}: largest difference from full space {err:.3e} m");
         errors.push(err);
@@ -421,15 +423,18 @@ fn held_nodes_move_at_the_anchor_rate_of_the_step() {
 #[test]
 fn port_outputs_alone_are_the_bits_of_the_full_outputs() {
     let cubature = {
-        let mut s = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 8);
-        s.basis = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Equilibrium, anchor_motion: true };
-        s.force.evaluation = ForceEvaluation::Cubature;
+        let mut s = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 8);
+        s.mode_selection = ModeSelection::Load;
+        s.static_correction = true;
+        s.linearization = Linearization::Equilibrium;
+        s.anchor_motion = true;
+        s.force_evaluation = ForceEvaluation::Cubature;
         s
     };
     for (label, solver) in
-        [("full space", full(0.01)), ("modal, lowest 6", SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 6)), ("modal, cubature", cubature)]
+        [("full space", full(0.01)), ("modal, lowest 6", Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 6)), ("modal, cubature", cubature)]
     {
-        let setup = scenes::canonical("paper-2d-top-row").unwrap().with_solver(solver);
+        let setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
         let (mut alone, mut after) = (setup.simulator().unwrap(), setup.simulator().unwrap());
         for k in 0..40 {
             for sim in [&mut alone, &mut after] {

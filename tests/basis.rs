@@ -12,11 +12,16 @@ use modal_mass_spring::physics::forces::{SpringForces, StiffnessPattern};
 use modal_mass_spring::physics::*;
 use modal_mass_spring::scenes;
 
-fn options(selection: ModeSelection, static_correction: bool, linearization: Linearization) -> BasisOptions {
-    BasisOptions { selection, static_correction, linearization, anchor_motion: false }
+fn options(mode_selection: ModeSelection, static_correction: bool, linearization: Linearization) -> Settings {
+    Settings { mode_selection, static_correction, linearization, ..paper() }
 }
 
-fn build(scene: &str, r: usize, o: &BasisOptions) -> (Scene, Basis) {
+/// The paper's basis: the lowest modes at rest.
+fn paper() -> Settings {
+    Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 0)
+}
+
+fn build(scene: &str, r: usize, o: &Settings) -> (Scene, Basis) {
     let setup = scenes::canonical(scene).unwrap();
     let s = setup.grid.build().unwrap();
     let b = basis::build(&s, &setup.loads, r, o).unwrap();
@@ -31,7 +36,7 @@ fn column(b: &Basis, j: usize) -> Vec<f64> {
 #[test]
 fn load_selection_leaves_out_what_gravity_does_not_excite() {
     // 2D, top row fixed: the lowest mode is a sideways sway, orthogonal to gravity along -y.
-    let (s, lowest) = build("paper-2d-top-row", 1, &BasisOptions::default());
+    let (s, lowest) = build("paper-2d-top-row", 1, &paper());
     let g = basis::load_patterns(&s, &Loads::physical(0), false).remove(0);
     let sway = column(&lowest, 0);
     let gnorm = g.iter().zip(&s.dof_mass).map(|(f, m)| f * f / m).sum::<f64>().sqrt();
@@ -46,7 +51,7 @@ fn load_selection_leaves_out_what_gravity_does_not_excite() {
     }
 
     // 3D sheet: the lowest modes are the out-of-plane cluster; the loaded ones lie in the plane.
-    let (_, lowest) = build("paper-3d-sheet", 8, &BasisOptions::default());
+    let (_, lowest) = build("paper-3d-sheet", 8, &paper());
     let (_, load) = build("paper-3d-sheet", 8, &options(ModeSelection::Load, false, Linearization::Rest));
     for j in 0..8 {
         let (lo, ld) = (column(&lowest, j), column(&load, j));
@@ -84,9 +89,8 @@ fn ritz_vectors_are_mass_orthonormal_and_diagonalise_k() {
             }
         }
         // modeFrequencies are the Ritz values.
-        let mut solver = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 8);
-        solver.basis = o.clone();
-        let sim = scenes::canonical(scene).unwrap().with_solver(solver).simulator().unwrap();
+        let solver = Settings { n_modes: 8, ..o.clone() };
+        let sim = scenes::canonical(scene).unwrap().with_settings(solver).simulator().unwrap();
         for (w, l) in sim.mode_frequencies().iter().zip(&b.modes.lambda) {
             assert!((w * w - l).abs() <= 1e-12 * l.max(1.0), "{scene}: frequency {w}, lambda {l}");
         }
@@ -113,7 +117,7 @@ fn the_static_correction_holds_the_sag() {
     // At rest: the static response K^-1 M g.
     let (s, b) = build("paper-2d-top-row", 4, &options(ModeSelection::Load, true, Linearization::Rest));
     let g = basis::load_patterns(&s, &Loads::physical(0), false).remove(0);
-    let (_, all) = build("paper-2d-top-row", s.n_dofs(), &BasisOptions::default());
+    let (_, all) = build("paper-2d-top-row", s.n_dofs(), &paper());
     // K^-1 M g from every mode: sum phi (phi^T M g) / lambda.
     let mut sag = vec![0.0; s.n_dofs()];
     for j in 0..all.modes.r {
@@ -125,9 +129,8 @@ fn the_static_correction_holds_the_sag() {
     let (_, plain) = build("paper-2d-top-row", 4, &options(ModeSelection::Load, false, Linearization::Rest));
     assert!(outside(&s, &plain, &sag) > 1e-3, "without the correction the sag lies outside the basis");
     // At the equilibrium: the displacement from rest, so a run starts exactly at rest.
-    let mut solver = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 4);
-    solver.basis = options(ModeSelection::Load, true, Linearization::Equilibrium);
-    let setup = scenes::canonical("paper-2d-top-corners").unwrap().with_solver(solver);
+    let solver = Settings { n_modes: 4, ..options(ModeSelection::Load, true, Linearization::Equilibrium) };
+    let setup = scenes::canonical("paper-2d-top-corners").unwrap().with_settings(solver);
     let mut sim = setup.simulator().unwrap();
     let rest = setup.grid.build().unwrap();
     let d = rest.dim;
@@ -150,7 +153,7 @@ fn the_equilibrium_balances_gravity_and_matches_a_damped_run() {
         let residual = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         assert!(residual <= 1e-9 * gravity, "{name}: residual {residual}");
         // A damped full-space run comes to rest there.
-        let mut damped = setup.with_solver(SolverParams::new(Reduction::Full, Integrator::NewmarkImplicit, 0));
+        let mut damped = setup.with_settings(Settings::new(Reduction::Full, Integrator::NewmarkImplicit, 0));
         damped.loads.damping_alpha = 20.0;
         let mut sim = damped.simulator().unwrap();
         for _ in 0..2000 {
@@ -170,7 +173,7 @@ fn the_equilibrium_removes_the_zero_eigenvalues_of_a_flat_3d_sheet() {
     setup.grid.aux_stiffness = 0.0;
     let s = setup.grid.build().unwrap();
     let all = s.n_dofs();
-    let at_rest = basis::build(&s, &setup.loads, all, &BasisOptions::default()).unwrap();
+    let at_rest = basis::build(&s, &setup.loads, all, &paper()).unwrap();
     let top = at_rest.modes.lambda[all - 1];
     assert!(at_rest.modes.lambda.iter().filter(|&&l| l <= 1e-10 * top).count() >= 42, "at rest: {:?}", &at_rest.modes.lambda[..4]);
     // Hung under gravity the sheet is in tension, and buckles out of its plane
@@ -179,9 +182,8 @@ fn the_equilibrium_removes_the_zero_eigenvalues_of_a_flat_3d_sheet() {
     let (lo, hi) = (eq.modes.lambda[0], eq.modes.lambda[all - 1]);
     assert!(lo > 1.0 && lo > 1e-6 * hi, "lowest eigenvalue at the equilibrium {lo} (highest {hi})");
     // And a run in its modes is stable.
-    let mut solver = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 16);
-    solver.basis = options(ModeSelection::Load, true, Linearization::Equilibrium);
-    let run = setup.with_solver(solver);
+    let solver = Settings { n_modes: 16, ..options(ModeSelection::Load, true, Linearization::Equilibrium) };
+    let run = setup.with_settings(solver);
     let mut sim = run.simulator().unwrap();
     let bound = s.free_mass() * 9.81 * s.reach();
     for _ in 0..200 {
@@ -197,13 +199,13 @@ fn all_modes_at_the_equilibrium_reproduce_full_space_to_round_off() {
     let setup = scenes::canonical("paper-2d-top-corners").unwrap();
     let n = setup.grid.build().unwrap().n_dofs();
     for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit] {
-        let mut modal = SolverParams::new(Reduction::Modal, integrator, n);
-        modal.basis.linearization = Linearization::Equilibrium;
+        let mut modal = Settings::new(Reduction::Modal, integrator, n);
+        modal.linearization = Linearization::Equilibrium;
         // Mass-proportional damping only: the modal space damps with the
         // stiffness at its linearization point, full space with the one at rest.
-        let mut a = setup.with_solver(modal);
+        let mut a = setup.with_settings(modal);
         a.loads.damping_alpha = 0.3;
-        let mut b = setup.with_solver(SolverParams::new(Reduction::Full, integrator, 0));
+        let mut b = setup.with_settings(Settings::new(Reduction::Full, integrator, 0));
         b.loads.damping_alpha = 0.3;
         let (mut sa, mut sb) = (a.simulator().unwrap(), b.simulator().unwrap());
         let start = sb.positions().to_vec();

@@ -10,10 +10,13 @@ use modal_mass_spring::fmi::variables::vr;
 use modal_mass_spring::physics::*;
 use modal_mass_spring::scenes;
 
-fn solver(integrator: Integrator, r: usize, linearization: Linearization, force: ForceEvaluation, tolerance: f64) -> SolverParams {
-    let mut s = SolverParams::new(Reduction::Modal, integrator, r);
-    s.basis = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization, anchor_motion: false };
-    s.force = ForceOptions { evaluation: force, cubature_tolerance: tolerance };
+fn solver(integrator: Integrator, r: usize, linearization: Linearization, force: ForceEvaluation, tolerance: f64) -> Settings {
+    let mut s = Settings::new(Reduction::Modal, integrator, r);
+    s.mode_selection = ModeSelection::Load;
+    s.static_correction = true;
+    s.linearization = linearization;
+    s.force_evaluation = force;
+    s.cubature_tolerance = tolerance;
     s.max_internal_step = 0.001;
     s
 }
@@ -69,8 +72,8 @@ fn cubature_reproduces_the_projected_force_on_held_out_poses() {
     ] {
         for tolerance in [0.01, 0.002] {
             let setup = scenes::canonical(name).unwrap();
-            let mut exact = setup.with_solver(solver(Integrator::NewmarkExplicit, r, lin, ForceEvaluation::Exact, tolerance)).simulator().unwrap();
-            let mut cubature = setup.with_solver(solver(Integrator::NewmarkExplicit, r, lin, ForceEvaluation::Cubature, tolerance)).simulator().unwrap();
+            let mut exact = setup.with_settings(solver(Integrator::NewmarkExplicit, r, lin, ForceEvaluation::Exact, tolerance)).simulator().unwrap();
+            let mut cubature = setup.with_settings(solver(Integrator::NewmarkExplicit, r, lin, ForceEvaluation::Cubature, tolerance)).simulator().unwrap();
             let poses = held_out_poses(&mut exact);
             let e = relative_force_error(&mut cubature, &mut exact, &poses);
             let (kept, all) = (cubature.cubature_springs(), exact.cubature_springs());
@@ -100,7 +103,7 @@ fn cubature_runs_follow_exact_forces_with_both_integrators() {
         let frames = |force| {
             let mut s = solver(integrator, 8, Linearization::Rest, force, 0.002);
             s.max_internal_step = 0.005;
-            let mut sim = setup.with_solver(s).simulator().unwrap();
+            let mut sim = setup.with_settings(s).simulator().unwrap();
             let mut out = vec![sim.positions().to_vec()];
             for _ in 0..200 {
                 sim.do_step(0.01).unwrap();

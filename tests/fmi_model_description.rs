@@ -125,7 +125,7 @@ fn defaults_are_paper_2d_top_row() {
     assert_eq!(default, Params::canonical("paper-2d-top-row").unwrap().grid());
     let p = Params::start();
     assert_eq!(p.get(variables::vr::N_MODES), [2.0]);
-    assert_eq!(p.solver().integrator, Integrator::NewmarkExplicit);
+    assert_eq!(p.settings().integrator, Integrator::NewmarkExplicit);
     assert_eq!(p.loads().damping_alpha, 0.0);
 }
 

@@ -11,11 +11,11 @@ fn scene(name: &str) -> Grid {
     scenes::canonical(name).unwrap().grid
 }
 
-fn solver(reduction: Reduction, integrator: Integrator, n_modes: usize) -> SolverParams {
-    SolverParams::new(reduction, integrator, n_modes)
+fn solver(reduction: Reduction, integrator: Integrator, n_modes: usize) -> Settings {
+    Settings::new(reduction, integrator, n_modes)
 }
 
-fn simulator(p: &Grid, s: &SolverParams, loads: &Loads) -> Simulator {
+fn simulator(p: &Grid, s: &Settings, loads: &Loads) -> Simulator {
     Simulator::new(p.build().unwrap(), s, loads).unwrap()
 }
 
@@ -111,7 +111,7 @@ fn small_amplitude_full_space_frequencies_equal_mode_frequencies() {
     }
 }
 
-fn run(p: &Grid, s: &SolverParams, t: &Loads, h: f64, steps: usize) -> Vec<Vec<f64>> {
+fn run(p: &Grid, s: &Settings, t: &Loads, h: f64, steps: usize) -> Vec<Vec<f64>> {
     let mut sim = simulator(p, s, t);
     (0..steps)
         .map(|_| {

@@ -17,8 +17,8 @@ const LOAD: [f64; 3] = [1.0, -2.0, 0.0];
 /// The paper's 2D scene (10 x 10, top row held) with `solver`, the point
 /// load on its default load node (row 9, column 5) and mass-proportional
 /// damping `alpha`.
-fn loaded(solver: SolverParams, alpha: f64) -> (Simulator, f64) {
-    let mut setup = scenes::canonical("paper-2d-top-row").unwrap().with_solver(solver);
+fn loaded(solver: Settings, alpha: f64) -> (Simulator, f64) {
+    let mut setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
     assert_eq!(setup.loads.load_node, Some(9 * 10 + 5), "the default load node is the middle of the bottom row");
     setup.loads.point_load = LOAD;
     setup.loads.damping_alpha = alpha;
@@ -49,9 +49,9 @@ const ALPHA: f64 = 8.0;
 fn at_rest_the_anchor_force_is_the_weight_plus_the_point_load() {
     let dofs = 180;
     for (label, solver) in [
-        ("full space", SolverParams::new(Reduction::Full, Integrator::NewmarkExplicit, 0)),
-        ("modal space, every mode", SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, dofs)),
-        ("full space, implicit", SolverParams::new(Reduction::Full, Integrator::NewmarkImplicit, 0)),
+        ("full space", Settings::new(Reduction::Full, Integrator::NewmarkExplicit, 0)),
+        ("modal space, every mode", Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, dofs)),
+        ("full space, implicit", Settings::new(Reduction::Full, Integrator::NewmarkImplicit, 0)),
     ] {
         let (mut sim, weight) = loaded(solver, ALPHA);
         let (rel, kinetic) = balance(&mut sim, weight, 20.0);
@@ -72,9 +72,10 @@ fn at_rest_the_anchor_force_is_the_weight_plus_the_point_load() {
 #[test]
 fn with_load_modes_and_static_correction_the_anchor_force_is_close() {
     let rel_at = |scale: f64| {
-        let mut solver = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 8);
-        solver.basis = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest, anchor_motion: false };
-        let mut setup = scenes::canonical("paper-2d-top-row").unwrap().with_solver(solver);
+        let mut solver = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 8);
+        solver.mode_selection = ModeSelection::Load;
+        solver.static_correction = true;
+        let mut setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
         setup.loads.gravity = [0.0, -9.81 * scale, 0.0];
         setup.loads.point_load = LOAD.map(|f| f * scale);
         setup.loads.damping_alpha = ALPHA;
@@ -100,9 +101,9 @@ fn with_load_modes_and_static_correction_the_anchor_force_is_close() {
 #[test]
 fn every_mode_matches_the_full_space_with_a_load_switched_on() {
     let run = |reduction| {
-        let mut solver = SolverParams::new(reduction, Integrator::NewmarkExplicit, if reduction == Reduction::Modal { 180 } else { 0 });
+        let mut solver = Settings::new(reduction, Integrator::NewmarkExplicit, if reduction == Reduction::Modal { 180 } else { 0 });
         solver.max_internal_step = 2e-4; // below both stable steps: the same internal steps in both spaces
-        let setup = scenes::canonical("paper-2d-top-row").unwrap().with_solver(solver);
+        let setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
         let mut sim = setup.simulator().unwrap();
         assert!(sim.max_stable_step() == 2e-4, "{reduction:?}: stable step {} below the bound", sim.max_stable_step());
         let mut trace = Vec::new();
@@ -139,7 +140,7 @@ fn every_mode_matches_the_full_space_with_a_load_switched_on() {
 
 #[test]
 fn a_point_load_needs_a_free_node_and_finite_values() {
-    let setup = scenes::canonical("paper-2d-top-row").unwrap().with_solver(SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 4));
+    let setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 4));
     let mut sim = setup.simulator().unwrap();
     sim.do_step(0.01).unwrap();
     let before = sim.snapshot();
@@ -161,9 +162,11 @@ fn a_point_load_needs_a_free_node_and_finite_values() {
 /// load and staticCorrection work from the point load alone.
 #[test]
 fn the_point_load_alone_is_a_load_pattern() {
-    let mut solver = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 6);
-    solver.basis = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Equilibrium, anchor_motion: false };
-    let mut setup = scenes::canonical("paper-2d-top-row").unwrap().with_solver(solver);
+    let mut solver = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 6);
+    solver.mode_selection = ModeSelection::Load;
+    solver.static_correction = true;
+    solver.linearization = Linearization::Equilibrium;
+    let mut setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
     setup.loads.gravity = [0.0; 3];
     assert_eq!(setup.simulator().err(), Some(PhysicsError::NoLoad));
     setup.loads.point_load = LOAD;

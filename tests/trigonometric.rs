@@ -359,15 +359,13 @@ fn the_static_solution_is_a_fixed_point_at_any_step() {
 // ---------------------------------------------------------------------------
 // The modal space.
 
-fn load_static() -> BasisOptions {
-    BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest, anchor_motion: false }
+/// Load modes with a static correction (at rest).
+fn load_static(s: Settings) -> Settings {
+    Settings { mode_selection: ModeSelection::Load, static_correction: true, ..s }
 }
 
-fn modal(integrator: Integrator, modes: usize, basis: BasisOptions, max_internal_step: f64) -> SolverParams {
-    let mut s = SolverParams::new(Reduction::Modal, integrator, modes);
-    s.basis = basis;
-    s.max_internal_step = max_internal_step;
-    s
+fn modal(integrator: Integrator, modes: usize, max_internal_step: f64) -> Settings {
+    Settings { max_internal_step, ..Settings::new(Reduction::Modal, integrator, modes) }
 }
 
 /// Total energy (kinetic + potential) of `sim`.
@@ -386,7 +384,7 @@ fn energy(sim: &mut Simulator) -> f64 {
 #[test]
 fn no_blow_up_at_steps_where_a_mode_turns_by_a_multiple_of_pi() {
     let setup = scenes::canonical("paper-2d-top-row").unwrap();
-    let probe = setup.with_solver(modal(Integrator::Trigonometric, 16, load_static(), 0.02)).simulator().unwrap();
+    let probe = setup.with_settings(load_static(modal(Integrator::Trigonometric, 16, 0.02))).simulator().unwrap();
     let omega = probe.mode_frequencies().to_vec();
     let pi = std::f64::consts::PI;
     let mut cases = Vec::new();
@@ -399,7 +397,7 @@ fn no_blow_up_at_steps_where_a_mode_turns_by_a_multiple_of_pi() {
     }
     let (mut worst_kinetic, mut worst_energy) = (0.0f64, 0.0f64);
     for (j, k, dt) in cases {
-        let mut sim = setup.with_solver(modal(Integrator::Trigonometric, 16, load_static(), dt)).simulator().unwrap();
+        let mut sim = setup.with_settings(load_static(modal(Integrator::Trigonometric, 16, dt))).simulator().unwrap();
         let e0 = energy(&mut sim);
         // The work gravity can do across the sheet: the scale of every energy here.
         let work = sim.scene().free_mass() * 9.81 * sim.scene().reach();
@@ -424,7 +422,7 @@ fn no_blow_up_at_steps_where_a_mode_turns_by_a_multiple_of_pi() {
 #[test]
 fn the_energy_of_a_long_undamped_run_stays_bounded() {
     let setup = scenes::canonical("paper-2d-top-row").unwrap();
-    let mut sim = setup.with_solver(modal(Integrator::Trigonometric, 16, load_static(), 0.02)).simulator().unwrap();
+    let mut sim = setup.with_settings(load_static(modal(Integrator::Trigonometric, 16, 0.02))).simulator().unwrap();
     let e0 = energy(&mut sim);
     let steps = 5000;
     let (mut k_max, mut first, mut last) = (0.0f64, 0.0f64, 0.0f64);
@@ -452,7 +450,7 @@ fn the_energy_of_a_long_undamped_run_stays_bounded() {
 #[test]
 fn a_step_too_long_for_the_stiffened_rest_of_the_force_is_refused() {
     let run = |dt: f64| {
-        let mut setup = scenes::canonical("paper-3d-sheet").unwrap().with_solver(modal(Integrator::Trigonometric, 58, BasisOptions::default(), dt));
+        let mut setup = scenes::canonical("paper-3d-sheet").unwrap().with_settings(modal(Integrator::Trigonometric, 58, dt));
         setup.loads.gravity = [0.0, -1e4, 0.0];
         setup.simulator().unwrap()
     };
@@ -508,7 +506,7 @@ fn agrees_with_explicit_newmark_at_small_steps() {
     let r = 8;
     let weights = [1.0, 0.5, 2.0, 1.0, 0.0, 1.0, 1.5, 1.0];
     let run = |integrator, dt: f64| {
-        let mut s = setup.with_solver(modal(integrator, r, BasisOptions::default(), dt));
+        let mut s = setup.with_settings(modal(integrator, r, dt));
         s.loads.mode_weights = weights.to_vec();
         s.loads.damping_alpha = 0.3;
         s.loads.damping_beta = 2e-4;
@@ -558,14 +556,16 @@ fn every_option_with_a_moving_anchor_and_a_point_load() {
     let mut cases = Vec::new();
     for linearization in [Linearization::Rest, Linearization::Equilibrium] {
         for evaluation in [ForceEvaluation::Exact, ForceEvaluation::Cubature] {
-            cases.push((BasisOptions { linearization, anchor_motion: true, ..load_static() }, evaluation));
+            cases.push((linearization, evaluation));
         }
     }
-    for (basis, evaluation) in cases {
+    for (linearization, evaluation) in cases {
         let sim = |integrator, dt| {
-            let mut s = modal(integrator, 8, basis.clone(), dt);
-            s.force.evaluation = evaluation;
-            let mut setup = setup.with_solver(s);
+            let mut s = load_static(modal(integrator, 8, dt));
+            s.linearization = linearization;
+            s.anchor_motion = true;
+            s.force_evaluation = evaluation;
+            let mut setup = setup.with_settings(s);
             setup.loads.point_load = [0.5, -1.0, 0.0];
             setup.simulator().unwrap()
         };
@@ -581,13 +581,13 @@ fn every_option_with_a_moving_anchor_and_a_point_load() {
         let moved = motion(&want, &start);
         println!(
             "{:?}, {evaluation:?}: trigonometric at 5 and 2.5 ms {err:.3e}, {err_halved:.3e} m; explicit Newmark at 5 ms ({} internal steps) {err_explicit:.3e} m; motion {moved:.3e} m",
-            basis.linearization,
+            linearization,
             explicit.internal_steps_last()
         );
         assert!(got.iter().flatten().all(|x| x.is_finite()));
-        assert!(err < 1e-2 * moved, "{:?}, {evaluation:?}: {err:e} m of {moved:e} m", basis.linearization);
-        assert!(err < err_explicit, "{:?}, {evaluation:?}: {err:e} m, explicit Newmark {err_explicit:e} m", basis.linearization);
-        assert!(err_halved < 0.35 * err, "{:?}, {evaluation:?}: not second order, {err:e} then {err_halved:e} m", basis.linearization);
+        assert!(err < 1e-2 * moved, "{:?}, {evaluation:?}: {err:e} m of {moved:e} m", linearization);
+        assert!(err < err_explicit, "{:?}, {evaluation:?}: {err:e} m, explicit Newmark {err_explicit:e} m", linearization);
+        assert!(err_halved < 0.35 * err, "{:?}, {evaluation:?}: not second order, {err:e} then {err_halved:e} m", linearization);
         let ports = [trig.load_node_position().unwrap(), trig.load_node_velocity().unwrap(), trig.anchor_force()];
         assert!(ports.iter().flatten().all(|x| x.is_finite()));
     }
@@ -636,7 +636,7 @@ fn fmi_state_resumes_bit_for_bit() {
 #[test]
 fn refused_in_full_space() {
     let setup = scenes::canonical("paper-2d-top-row").unwrap();
-    let err = setup.with_solver(SolverParams::new(Reduction::Full, Integrator::Trigonometric, 0)).simulator().err();
+    let err = setup.with_settings(Settings::new(Reduction::Full, Integrator::Trigonometric, 0)).simulator().err();
     assert_eq!(err, Some(PhysicsError::SchemeNeedsDiagonal { scheme: Integrator::Trigonometric }));
     let f = Fmu::new();
     assert_eq!(f.set_i64(vr::INTEGRATOR, 3), OK);

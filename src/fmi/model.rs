@@ -5,7 +5,7 @@
 
 use super::variables::{index_of, vr, Dim, Variability, Variable, SCENES, VARIABLES};
 use crate::options::{FixedNodes, ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction};
-use crate::physics::{BasisOptions, ForceOptions, Grid, Loads, PhysicsError, SetupData, Simulator, SolverParams};
+use crate::physics::{Grid, Loads, PhysicsError, Settings, SetupData, Simulator};
 
 /// Current values of the parameters and inputs, indexed like [`VARIABLES`]
 /// (empty for the other variables). Booleans are 0/1, integers exact
@@ -137,21 +137,17 @@ impl Params {
         }
     }
 
-    pub fn solver(&self) -> SolverParams {
-        SolverParams {
+    pub fn settings(&self) -> Settings {
+        Settings {
             reduction: self.enumeration(vr::REDUCTION, Reduction::from_value),
             integrator: self.enumeration(vr::INTEGRATOR, Integrator::from_value),
             n_modes: self.count(vr::N_MODES),
-            basis: BasisOptions {
-                selection: self.enumeration(vr::MODE_SELECTION, ModeSelection::from_value),
-                static_correction: self.scalar(vr::STATIC_CORRECTION) != 0.0,
-                linearization: self.enumeration(vr::LINEARIZATION, Linearization::from_value),
-                anchor_motion: self.scalar(vr::ANCHOR_MOTION) != 0.0,
-            },
-            force: ForceOptions {
-                evaluation: self.enumeration(vr::FORCE_EVALUATION, ForceEvaluation::from_value),
-                cubature_tolerance: self.scalar(vr::CUBATURE_TOLERANCE),
-            },
+            mode_selection: self.enumeration(vr::MODE_SELECTION, ModeSelection::from_value),
+            static_correction: self.scalar(vr::STATIC_CORRECTION) != 0.0,
+            linearization: self.enumeration(vr::LINEARIZATION, Linearization::from_value),
+            anchor_motion: self.scalar(vr::ANCHOR_MOTION) != 0.0,
+            force_evaluation: self.enumeration(vr::FORCE_EVALUATION, ForceEvaluation::from_value),
+            cubature_tolerance: self.scalar(vr::CUBATURE_TOLERANCE),
             max_internal_step: self.scalar(vr::MAX_INTERNAL_STEP),
             substepping: true,
         }
@@ -207,7 +203,7 @@ impl Params {
         if self.load_node_problem().is_some() {
             return Err(PhysicsError::LoadNode { node: self.load_node(), held: self.load_node().is_some() });
         }
-        Simulator::with_setup(scene, &self.solver(), &self.loads(), prebuilt)
+        Simulator::with_setup(scene, &self.settings(), &self.loads(), prebuilt)
     }
 }
 

@@ -29,8 +29,8 @@ use super::error::PhysicsError;
 use super::forces::StiffnessPattern;
 use super::modes::ModalBasis;
 use super::scene::Scene;
+use super::settings::{Linearization, ModeSelection, Settings};
 use super::state::Loads;
-pub use crate::options::{Linearization, ModeSelection};
 
 /// Scenes up to this many free DOFs rank every mode (a dense decomposition);
 /// larger ones rank load-dependent Ritz pairs.
@@ -41,24 +41,6 @@ const RITZ_EXTRA: usize = 16;
 /// A vector whose M-norm falls below this fraction of its own after
 /// orthogonalization against the basis is taken as already in it.
 const DEPENDENT: f64 = 1e-8;
-
-/// How the basis is built.
-#[derive(Clone, Debug, PartialEq)]
-pub struct BasisOptions {
-    pub selection: ModeSelection,
-    pub static_correction: bool,
-    pub linearization: Linearization,
-    /// The anchor will move: its inertial load along each axis, M e_i, is
-    /// a load pattern (`docs/method.md`, section 8).
-    pub anchor_motion: bool,
-}
-
-impl Default for BasisOptions {
-    /// The paper's: the lowest modes at rest, no correction.
-    fn default() -> Self {
-        BasisOptions { selection: ModeSelection::Lowest, static_correction: false, linearization: Linearization::Rest, anchor_motion: false }
-    }
-}
 
 /// A linearization point and the modes built there.
 pub struct Basis {
@@ -108,35 +90,37 @@ pub fn external_load(scene: &Scene, loads: &Loads) -> Vec<f64> {
     f
 }
 
-/// The basis of `n_modes` vectors `options` ask for on `scene` under `loads`.
-pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, options: &BasisOptions) -> Result<Basis, PhysicsError> {
+/// The basis of `n_modes` vectors on `scene` under `loads`, chosen and
+/// linearized as `settings` ask (`mode_selection`, `static_correction`,
+/// `linearization`, `anchor_motion`).
+pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) -> Result<Basis, PhysicsError> {
     let n = scene.n_dofs();
     if n_modes > n {
         return Err(PhysicsError::ModesExceedDofs { modes: n_modes, dofs: n });
     }
     let pattern = StiffnessPattern::new(scene);
-    let point = match options.linearization {
+    let point = match settings.linearization {
         Linearization::Rest => scene.rest.clone(),
         Linearization::Equilibrium => equilibrium(scene, &pattern, &external_load(scene, loads))?,
     };
     let mut stiffness = vec![0.0; pattern.nnz()];
     pattern.add_tangent(scene, &point, 1.0, &mut stiffness);
-    let at_rest = options.linearization == Linearization::Rest;
-    let patterns = load_patterns(scene, loads, options.anchor_motion);
-    let needs_load = options.selection == ModeSelection::Load || options.static_correction;
+    let at_rest = settings.linearization == Linearization::Rest;
+    let patterns = load_patterns(scene, loads, settings.anchor_motion);
+    let needs_load = settings.mode_selection == ModeSelection::Load || settings.static_correction;
     if needs_load && patterns.is_empty() {
         return Err(PhysicsError::NoLoad);
     }
-    let plain = options.selection == ModeSelection::Lowest && !options.static_correction;
+    let plain = settings.mode_selection == ModeSelection::Lowest && !settings.static_correction;
     let modes = if plain {
         ModalBasis::lowest(scene, &pattern, &stiffness, n_modes)?
     } else {
-        let statics = if options.static_correction { patterns.len().min(n_modes) } else { 0 };
+        let statics = if settings.static_correction { patterns.len().min(n_modes) } else { 0 };
         let eigen = n_modes - statics;
         // Candidates in the order they are wanted; a few more than needed
         // stand in for static responses the modes already hold.
-        let spare = if options.static_correction { statics } else { 0 };
-        let candidates = match options.selection {
+        let spare = if settings.static_correction { statics } else { 0 };
+        let candidates = match settings.mode_selection {
             ModeSelection::Lowest => ModalBasis::lowest(scene, &pattern, &stiffness, (eigen + spare).min(n))?,
             ModeSelection::Load => {
                 // Away from rest the run starts displaced from x* by x_rest - x*: its modal amplitudes count too.
@@ -146,14 +130,14 @@ pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, options: &BasisOption
         };
         let columns = |b: &ModalBasis, j: usize| -> Vec<f64> { (0..n).map(|i| b.phi[i * b.r + j]).collect() };
         let mut vectors: Vec<Vec<f64>> = (0..eigen.min(candidates.r)).map(|j| columns(&candidates, j)).collect();
-        if options.static_correction {
+        if settings.static_correction {
             if at_rest {
                 let solver = ShiftedStiffness::new(scene, &pattern, &stiffness)?;
                 vectors.extend(patterns.iter().map(|f| solver.solve(f)));
             } else {
                 // At the equilibrium the sag is known exactly: the displacement from rest.
                 vectors.push((0..n).map(|k| point[k] - scene.rest[k]).collect());
-                if options.anchor_motion {
+                if settings.anchor_motion {
                     // The anchor's inertial loads act around the equilibrium, through its tangent stiffness.
                     let solver = ShiftedStiffness::new(scene, &pattern, &stiffness)?;
                     vectors.extend(patterns.iter().take(scene.dim).map(|f| solver.solve(f)));

@@ -1,17 +1,46 @@
 //! A space and a scheme bound together with their scratch: the one place
 //! where the two meet. [`Engine`] is generic, so a step calls the space
 //! without indirection; the simulator holds it behind the object-safe
-//! [`Stepper`], chosen once at set-up by the registries
-//! ([`super::space::build`], [`super::integrator::bind`]).
+//! [`Stepper`], chosen once at set-up by the registry [`build`] (which
+//! space, which force model, which scheme, as the [`Settings`] name them).
+//!
+//! The dependencies run one way: the simulator uses this module; this
+//! module uses the spaces and the schemes; the schemes use the spaces.
 
 use std::marker::PhantomData;
 
 use super::bake::SetupData;
 use super::error::{PhysicsError, StepFailure};
-use super::integrator::{Buffers, Scheme};
+use super::integrator::{Buffers, NewmarkExplicit, NewmarkImplicit, Scheme, Trigonometric};
 use super::scene::Scene;
-use super::space::Space;
+use super::settings::{ForceEvaluation, Integrator, Reduction, Settings};
+use super::space::{Cubature, Exact, Full, Modal, Space};
 use super::state::{Loads, State};
+
+/// The registry: builds the space `settings.reduction` names on `scene`
+/// (with the force model `settings.force_evaluation` names in the modal
+/// space) and binds it to the scheme `settings.integrator` names, or
+/// refuses a pair the scheme cannot integrate. `loads` are those at
+/// set-up: the basis options that depend on the loads use them.
+/// `prebuilt` (modal space only) replaces the costly part of the set-up.
+pub(crate) fn build(scene: Scene, settings: &Settings, loads: &Loads, prebuilt: Option<&SetupData>) -> Result<Box<dyn Stepper>, PhysicsError> {
+    match settings.reduction {
+        Reduction::Modal => match settings.force_evaluation {
+            ForceEvaluation::Exact => bind(Modal::<Exact>::new(scene, loads, settings, prebuilt)?, settings.integrator),
+            ForceEvaluation::Cubature => bind(Modal::<Cubature>::new(scene, loads, settings, prebuilt)?, settings.integrator),
+        },
+        Reduction::Full => bind(Full::new(scene, loads, settings)?, settings.integrator),
+    }
+}
+
+/// Binds `space` to the scheme `kind` names.
+fn bind<S: Space>(space: S, kind: Integrator) -> Result<Box<dyn Stepper>, PhysicsError> {
+    Ok(match kind {
+        Integrator::NewmarkExplicit => Box::new(Engine::<S, NewmarkExplicit>::new(space)?),
+        Integrator::NewmarkImplicit => Box::new(Engine::<S, NewmarkImplicit>::new(space)?),
+        Integrator::Trigonometric => Box::new(Engine::<S, Trigonometric>::new(space)?),
+    })
+}
 
 /// What the simulator asks of a bound space and scheme.
 pub trait Stepper: Send {

@@ -8,7 +8,7 @@
 
 use std::fmt;
 
-use super::integrator::Integrator;
+use crate::options::Integrator;
 
 /// A quantity of the scene, the solver, the loads or a step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,4 +1,4 @@
-//! The simulator: set-up (the space and scheme the solver parameters name,
+//! The simulator: set-up (the space and scheme the settings name,
 //! bound once), the communication step split into internal steps, the
 //! checks that catch a diverging step, and the outputs.
 //!
@@ -12,49 +12,11 @@
 //! those (`docs/method.md`, section 4).
 
 use super::bake::SetupData;
-use super::basis::BasisOptions;
-use super::engine::{Outputs, Stepper};
+use super::engine::{self, Outputs, Stepper};
 use super::error::{positive, Expected, PhysicsError, Quantity, StepFailure};
-use super::integrator::Integrator;
 use super::scene::Scene;
-use super::space::{self, ForceOptions, Reduction};
+use super::settings::{Reduction, Settings};
 use super::state::{Loads, Snapshot, State};
-
-/// How a scene is integrated.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SolverParams {
-    /// Space the equations live in.
-    pub reduction: Reduction,
-    /// Scheme of the internal steps.
-    pub integrator: Integrator,
-    /// Modes kept by the modal space; in full space the number of modes
-    /// whose frequencies and coordinates are reported (0: none).
-    pub n_modes: usize,
-    /// How the modes are chosen (`docs/method.md`, section 3).
-    pub basis: BasisOptions,
-    /// How the modal space evaluates the projected spring force (`docs/method.md`, section 4).
-    pub force: ForceOptions,
-    /// Upper bound on one internal step [s].
-    pub max_internal_step: f64,
-    /// Split a communication step into internal steps that keep the
-    /// explicit integrator stable. Only tests switch this off, to show why it exists.
-    pub substepping: bool,
-}
-
-impl SolverParams {
-    /// `n_modes` modes, the given space and scheme, internal steps of at most 10 ms.
-    pub fn new(reduction: Reduction, integrator: Integrator, n_modes: usize) -> Self {
-        SolverParams {
-            reduction,
-            integrator,
-            n_modes,
-            basis: BasisOptions::default(),
-            force: ForceOptions::default(),
-            max_internal_step: 0.01,
-            substepping: true,
-        }
-    }
-}
 
 /// Internal steps one communication step may take before it is refused.
 pub const MAX_INTERNAL_STEPS_PER_CALL: usize = 10_000_000;
@@ -96,7 +58,7 @@ struct Fresh {
 
 pub struct Simulator {
     engine: Box<dyn Stepper>,
-    solver: SolverParams,
+    settings: Settings,
     state: State,
     loads: Loads,
     /// The state at the start of the current communication step, restored
@@ -117,28 +79,28 @@ pub struct Simulator {
 }
 
 impl Simulator {
-    /// Set-up: builds the space the solver names on `scene` (assembly,
+    /// Set-up: builds the space the settings names on `scene` (assembly,
     /// eigen decomposition, factorizations), binds its scheme and bounds
     /// its step. Refuses what it cannot run, naming the quantity.
-    pub fn new(scene: Scene, solver: &SolverParams, loads: &Loads) -> Result<Self, PhysicsError> {
-        Self::with_setup(scene, solver, loads, None)
+    pub fn new(scene: Scene, settings: &Settings, loads: &Loads) -> Result<Self, PhysicsError> {
+        Self::with_setup(scene, settings, loads, None)
     }
 
     /// [`Self::new`], with the costly part of a modal set-up taken from
     /// `prebuilt` (see [`SetupData`]) when given: the run is then bit for
     /// bit that of a simulator that computed it for the same parameters.
-    pub fn with_setup(scene: Scene, solver: &SolverParams, loads: &Loads, prebuilt: Option<&SetupData>) -> Result<Self, PhysicsError> {
+    pub fn with_setup(scene: Scene, settings: &Settings, loads: &Loads, prebuilt: Option<&SetupData>) -> Result<Self, PhysicsError> {
         scene.check()?;
-        positive(Quantity::MaxInternalStep, solver.max_internal_step)?;
-        if solver.reduction == Reduction::Modal && solver.n_modes == 0 {
+        positive(Quantity::MaxInternalStep, settings.max_internal_step)?;
+        if settings.reduction == Reduction::Modal && settings.n_modes == 0 {
             return Err(PhysicsError::Invalid { quantity: Quantity::Modes, value: 0.0, expected: Expected::AtLeast(1.0) });
         }
-        loads.validate(solver.n_modes)?;
+        loads.validate(settings.n_modes)?;
         loads.validate_on(&scene)?;
         let (free_mass, reach) = (scene.free_mass(), scene.reach());
         let spacing = scene.springs.iter().map(|s| s.rest).filter(|&l| l > 0.0).fold(f64::INFINITY, f64::min);
         let dim = scene.dim;
-        let mut engine = space::build(scene, solver, loads, prebuilt)?;
+        let mut engine = engine::build(scene, settings, loads, prebuilt)?;
         engine.apply_loads(loads);
         let mut state = State::at_rest(engine.coordinates());
         engine.rest_coordinates(&mut state.y);
@@ -146,13 +108,13 @@ impl Simulator {
         state.anchor[..dim].copy_from_slice(&loads.anchor[..dim]);
         engine.settle(loads, &mut state);
         let mut sim = Simulator {
-            outputs: Outputs::new(engine.scene(), solver.n_modes),
+            outputs: Outputs::new(engine.scene(), settings.n_modes),
             fresh: Fresh::default(),
             energy: 0.0,
             backup: state.clone(),
             state,
             engine,
-            solver: solver.clone(),
+            settings: settings.clone(),
             loads: loads.clone(),
             internal_steps_last: 0,
             free_mass,
@@ -168,11 +130,11 @@ impl Simulator {
     /// step bound into more than [`MAX_STABLE_SUBSTEPS`] internal steps,
     /// saying what sets the limit and what would lift it.
     fn check_stable_step_cost(&self) -> Result<(), PhysicsError> {
-        if !self.solver.substepping {
+        if !self.settings.substepping {
             return Ok(());
         }
         let dt = self.max_stable_step();
-        let per_step = self.solver.max_internal_step / dt;
+        let per_step = self.settings.max_internal_step / dt;
         if per_step <= MAX_STABLE_SUBSTEPS {
             return Ok(());
         }
@@ -181,7 +143,7 @@ impl Simulator {
             omega_max: self.engine.omega_sq_bound(&self.loads).sqrt(),
             stiffness_per_mass: self.engine.scene().stiffness_per_mass(),
             per_step,
-            max_internal_step: self.solver.max_internal_step,
+            max_internal_step: self.settings.max_internal_step,
             limit: MAX_STABLE_SUBSTEPS,
             modes: self.engine.kept_modes(),
         })
@@ -191,7 +153,7 @@ impl Simulator {
     /// stability limit under the current loads (weights above 1 scale the
     /// stiffness a mode sees).
     pub fn max_stable_step(&self) -> f64 {
-        let bound = self.solver.max_internal_step;
+        let bound = self.settings.max_internal_step;
         self.engine.stable_step(&self.loads).map_or(bound, |dt| bound.min(dt))
     }
 
@@ -200,7 +162,7 @@ impl Simulator {
     pub fn do_step(&mut self, h: f64) -> Result<(), PhysicsError> {
         positive(Quantity::StepSize, h)?;
         let dt_max = self.max_stable_step();
-        let steps = if self.solver.substepping { internal_step_count(h, dt_max) } else { 1.0 };
+        let steps = if self.settings.substepping { internal_step_count(h, dt_max) } else { 1.0 };
         if steps > MAX_INTERNAL_STEPS_PER_CALL as f64 {
             return Err(PhysicsError::TooManyInternalSteps { h, steps, dt: dt_max, limit: MAX_INTERNAL_STEPS_PER_CALL });
         }
@@ -407,8 +369,8 @@ impl Simulator {
     pub fn loads(&self) -> &Loads {
         &self.loads
     }
-    pub fn solver(&self) -> &SolverParams {
-        &self.solver
+    pub fn settings(&self) -> &Settings {
+        &self.settings
     }
     /// Internal steps taken by the last successful `do_step`.
     pub fn internal_steps_last(&self) -> usize {
@@ -421,7 +383,7 @@ impl Simulator {
         if *loads == self.loads {
             return Ok(());
         }
-        loads.validate(self.solver.n_modes)?;
+        loads.validate(self.settings.n_modes)?;
         loads.validate_on(self.scene())?;
         if loads.same_but_anchor(&self.loads) {
             // The anchor's target acts from the next step on; nothing moves now.
@@ -440,7 +402,7 @@ impl Simulator {
         Snapshot { state: self.state.clone(), loads: self.loads.clone() }
     }
 
-    /// Resumes from a snapshot of a simulator of the same scene and solver.
+    /// Resumes from a snapshot of a simulator of the same scene and settings.
     /// On error nothing changes.
     pub fn restore(&mut self, s: &Snapshot) -> Result<(), PhysicsError> {
         let n = self.state.len();
@@ -452,7 +414,7 @@ impl Simulator {
         if !s.state.is_finite() {
             return Err(PhysicsError::SnapshotNotFinite);
         }
-        s.loads.validate(self.solver.n_modes)?;
+        s.loads.validate(self.settings.n_modes)?;
         s.loads.validate_on(self.scene())?;
         self.loads.clone_from(&s.loads);
         self.engine.apply_loads(&self.loads);

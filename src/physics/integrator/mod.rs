@@ -13,11 +13,9 @@ pub use newmark_explicit::NewmarkExplicit;
 pub use newmark_implicit::NewmarkImplicit;
 pub use trigonometric::{Propagator, Trigonometric};
 
-use super::engine::{Engine, Stepper};
 use super::error::{PhysicsError, StepFailure};
 use super::space::Space;
 use super::state::{Loads, State};
-pub use crate::options::Integrator;
 
 /// Explicit steps are kept at this fraction of the stability limit 2 / omega.
 pub const EXPLICIT_SAFETY: f64 = 0.9;
@@ -93,16 +91,6 @@ impl Buffers {
             scheme: vec![f64::NAN; n * scratch],
         }
     }
-}
-
-/// The registry of schemes: binds `space` to the scheme `kind` names, or
-/// refuses a pair the scheme cannot integrate.
-pub(crate) fn bind<S: Space>(space: S, kind: Integrator) -> Result<Box<dyn Stepper>, PhysicsError> {
-    Ok(match kind {
-        Integrator::NewmarkExplicit => Box::new(Engine::<S, NewmarkExplicit>::new(space)?),
-        Integrator::NewmarkImplicit => Box::new(Engine::<S, NewmarkImplicit>::new(space)?),
-        Integrator::Trigonometric => Box::new(Engine::<S, Trigonometric>::new(space)?),
-    })
 }
 
 /// Newmark predictor y1 = y + dt v + dt^2/2 a (exact for the explicit

@@ -64,7 +64,7 @@ impl Scheme for Trigonometric {
     fn check<S: Space>(space: &S, w: &S::Work) -> Result<(), PhysicsError> {
         match space.diagonal(w) {
             Some(_) => Ok(()),
-            None => Err(PhysicsError::SchemeNeedsDiagonal { scheme: super::Integrator::Trigonometric }),
+            None => Err(PhysicsError::SchemeNeedsDiagonal { scheme: crate::physics::settings::Integrator::Trigonometric }),
         }
     }
 

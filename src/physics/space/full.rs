@@ -17,11 +17,12 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
 use super::{Diagonal, Space};
-use crate::physics::basis::{self, BasisOptions};
+use crate::physics::basis;
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::forces::{linearize, omega_sq_bound_full, SpringForces, SpringScratch, StiffnessPattern};
 use crate::physics::modes::ModalBasis;
 use crate::physics::scene::Scene;
+use crate::physics::settings::Settings;
 use crate::physics::state::Loads;
 
 /// The constant model of the full-space equations.
@@ -67,10 +68,11 @@ impl Full {
     /// Assembles the stiffness at rest and its symbolic Cholesky analysis;
     /// builds the basis of `reported_modes` vectors `options` ask for (under
     /// the set-up `loads`) when that is not 0, to report its coordinates.
-    pub fn new(scene: Scene, reported_modes: usize, loads: &Loads, options: &BasisOptions) -> Result<Self, PhysicsError> {
+    pub fn new(scene: Scene, loads: &Loads, settings: &Settings) -> Result<Self, PhysicsError> {
+        let reported_modes = settings.n_modes;
         let (pattern, k0) = linearize(&scene);
         let (reported, reported_offset) = if reported_modes > 0 {
-            let b = basis::build(&scene, loads, reported_modes, options)?;
+            let b = basis::build(&scene, loads, reported_modes, settings)?;
             let offset = (!b.at_rest).then(|| (0..scene.n_dofs()).map(|k| scene.rest[k] - b.point[k]).collect());
             (Some(b.modes), offset)
         } else {

@@ -29,29 +29,9 @@ pub use full::Full;
 pub use modal::{Cubature, Exact, ForceSetup, Modal, Modes, ReducedForce};
 
 use super::bake::SetupData;
-use super::engine::Stepper;
-use super::error::{PhysicsError, StepFailure};
-use super::integrator;
+use super::error::StepFailure;
 use super::scene::Scene;
-use super::simulator::SolverParams;
 use super::state::Loads;
-pub use crate::options::{ForceEvaluation, Reduction};
-
-/// How the modal space evaluates the projected spring force (`docs/method.md`, section 4).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ForceOptions {
-    pub evaluation: ForceEvaluation,
-    /// With [`ForceEvaluation::Cubature`]: the relative error of Phi^T f on
-    /// the training and held-out poses the cubature set is grown to reach.
-    pub cubature_tolerance: f64,
-}
-
-impl Default for ForceOptions {
-    /// The paper's: every spring.
-    fn default() -> Self {
-        ForceOptions { evaluation: ForceEvaluation::Exact, cubature_tolerance: 0.01 }
-    }
-}
 
 /// The linear part of the equations when it is diagonal, as in the modal
 /// space: h_i(y) = g_i(y) - lambda_i y_i and C = diag(c_i), so that every
@@ -170,22 +150,4 @@ pub trait Space: Send + Sized + 'static {
     /// The part of the physical force at y the space cannot represent,
     /// relative to the load (`docs/method.md`, section 6); 0 in full space.
     fn force_residual(&self, loads: &Loads, y: &[f64], w: &mut Self::Work) -> f64;
-}
-
-/// The registry of spaces: builds the space `solver.reduction` names on
-/// `scene` and binds it to the integrator `solver.integrator` names.
-/// `loads` are those at set-up: the basis options that depend on the loads use them.
-/// `prebuilt` (modal space only) replaces the costly part of the set-up.
-pub(crate) fn build(scene: Scene, solver: &SolverParams, loads: &Loads, prebuilt: Option<&SetupData>) -> Result<Box<dyn Stepper>, PhysicsError> {
-    match solver.reduction {
-        Reduction::Modal => match solver.force.evaluation {
-            ForceEvaluation::Exact => {
-                integrator::bind(Modal::<Exact>::new(scene, solver.n_modes, loads, &solver.basis, &solver.force, prebuilt)?, solver.integrator)
-            }
-            ForceEvaluation::Cubature => {
-                integrator::bind(Modal::<Cubature>::new(scene, solver.n_modes, loads, &solver.basis, &solver.force, prebuilt)?, solver.integrator)
-            }
-        },
-        Reduction::Full => integrator::bind(Full::new(scene, solver.n_modes, loads, &solver.basis)?, solver.integrator),
-    }
 }

@@ -340,7 +340,7 @@ fn norm(v: &[f64]) -> f64 {
 
 /// Chooses the springs and their weights; see the module documentation.
 fn train<const D: usize>(scene: &Scene, modes: &Modes, setup: &ForceSetup) -> Result<SpringSet, PhysicsError> {
-    let tol = setup.options.cubature_tolerance;
+    let tol = setup.settings.cubature_tolerance;
     if !(tol > 0.0 && tol <= 1.0) {
         return Err(PhysicsError::Invalid {
             quantity: crate::physics::error::Quantity::CubatureTolerance,
@@ -563,7 +563,7 @@ fn poses(
     let (n, r) = (modes.basis.n, modes.basis.r);
     let mut gravity = vec![0.0; r];
     let mut load = crate::physics::basis::external_load(scene, setup.loads);
-    if setup.anchor_motion {
+    if setup.settings.anchor_motion {
         // An anchor accelerating at |g| (at least 1 m/s^2) along every axis at once adds its inertial load.
         let accel = setup.loads.gravity[..scene.dim].iter().map(|g| g * g).sum::<f64>().sqrt().max(1.0);
         for (k, fk) in load.iter_mut().enumerate() {
@@ -636,23 +636,46 @@ fn poses(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::options::ForceEvaluation;
-    use crate::physics::basis::{self, BasisOptions, Linearization, ModeSelection};
-    use crate::physics::space::ForceOptions;
-    use crate::scenes;
+    use crate::physics::basis;
+    use crate::physics::grid::{FixedNodes, Grid};
+    use crate::physics::settings::{ForceEvaluation, Integrator, ModeSelection, Reduction, Settings};
+    use crate::physics::state::Loads;
+
+    /// The paper's sheets: 10 x 10 in 2D, 7 x 7 in 3D with auxiliary springs, top row held, under gravity.
+    fn sheet(name: &str) -> (Grid, Loads) {
+        let dim = if name.contains("3d") { 3 } else { 2 };
+        let (columns, rows) = if dim == 3 { (7, 7) } else { (10, 10) };
+        let grid = Grid {
+            columns,
+            rows,
+            dim,
+            spacing: 0.1,
+            node_mass: 0.01,
+            spring_stiffness: 50.0,
+            shear_springs: true,
+            bending_springs: false,
+            aux_stiffness: if dim == 3 { 0.05 } else { 0.0 },
+            fixed_nodes: FixedNodes::TopRow,
+        };
+        let loads = Loads::physical(6);
+        (grid, loads)
+    }
 
     /// A cubature model of `name` on 6 load modes with a static correction.
     fn model(name: &str) -> (Scene, Modes, Cubature) {
-        let setup = scenes::canonical(name).unwrap();
-        let scene = setup.grid.build().unwrap();
-        let options = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest, anchor_motion: false };
-        let built = basis::build(&scene, &setup.loads, 6, &options).unwrap();
+        let (grid, loads) = sheet(name);
+        let scene = grid.build().unwrap();
+        let settings = Settings {
+            mode_selection: ModeSelection::Load,
+            static_correction: true,
+            force_evaluation: ForceEvaluation::Cubature,
+            cubature_tolerance: 0.002,
+            ..Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 6)
+        };
+        let built = basis::build(&scene, &loads, 6, &settings).unwrap();
         let modes = Modes::new(built.modes, built.point, built.at_rest);
         let bound = super::super::taut_reduced_bound(&scene, &modes.basis).unwrap();
-        let force = ForceOptions { evaluation: ForceEvaluation::Cubature, cubature_tolerance: 0.002 };
-        let cub =
-            Cubature::new(&scene, &modes, &ForceSetup { loads: &setup.loads, options: &force, anchor_motion: false, omega_sq_bound: bound, prebuilt: None })
-                .unwrap();
+        let cub = Cubature::new(&scene, &modes, &ForceSetup { loads: &loads, settings: &settings, omega_sq_bound: bound, prebuilt: None }).unwrap();
         (scene, modes, cub)
     }
 

@@ -26,13 +26,14 @@ mod exact;
 pub use cubature::Cubature;
 pub use exact::Exact;
 
-use super::{Diagonal, ForceOptions, Space};
+use super::{Diagonal, Space};
 use crate::physics::bake::{SetupData, SpringSet};
-use crate::physics::basis::{self, BasisOptions};
+use crate::physics::basis;
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::forces::{add_reduced_tangent, omega_sq_bound_full};
 use crate::physics::modes::ModalBasis;
 use crate::physics::scene::Scene;
+use crate::physics::settings::Settings;
 use crate::physics::state::Loads;
 
 /// Above this many modes the explicit limit uses the full-space bound
@@ -84,9 +85,8 @@ pub trait ReducedForce: Send + Sized + 'static {
 pub struct ForceSetup<'a> {
     /// The loads at set-up.
     pub loads: &'a Loads,
-    pub options: &'a ForceOptions,
-    /// The anchor will move (see [`crate::physics::basis::BasisOptions::anchor_motion`]).
-    pub anchor_motion: bool,
+    /// The set-up's settings (the cubature's tolerance, whether the anchor will move).
+    pub settings: &'a Settings,
     /// Squared-frequency bound of the reduced system with every spring (1/s^2).
     pub omega_sq_bound: f64,
     /// A stored set of springs and weights to use instead of computing one.
@@ -187,25 +187,19 @@ pub struct ModalWork<W> {
 }
 
 impl<F: ReducedForce> Modal<F> {
-    /// Builds the basis of `n_modes` vectors `options` ask for (under the
-    /// set-up `loads`) and sets up the force model.
+    /// Builds the basis of `settings.n_modes` vectors `settings` ask for
+    /// (under the set-up `loads`) and sets up the force model.
     /// The basis, its point and the bound come from `prebuilt` when given
     /// (checked to fit), else they are computed.
-    pub fn new(
-        scene: Scene,
-        n_modes: usize,
-        loads: &Loads,
-        options: &BasisOptions,
-        force_options: &ForceOptions,
-        prebuilt: Option<&SetupData>,
-    ) -> Result<Self, PhysicsError> {
+    pub fn new(scene: Scene, loads: &Loads, settings: &Settings, prebuilt: Option<&SetupData>) -> Result<Self, PhysicsError> {
+        let n_modes = settings.n_modes;
         let (modes, bound) = match prebuilt {
             Some(data) => {
                 check_prebuilt(&scene, n_modes, data)?;
                 (Modes::new(data.basis.clone(), data.point.clone(), data.at_rest), data.omega_sq_bound)
             }
             None => {
-                let built = basis::build(&scene, loads, n_modes, options)?;
+                let built = basis::build(&scene, loads, n_modes, settings)?;
                 let basis = built.modes;
                 let bound = if basis.r <= DENSE_BOUND_MODES { taut_reduced_bound(&scene, &basis)? } else { omega_sq_bound_full(&scene) };
                 (Modes::new(basis, built.point, built.at_rest), bound)
@@ -213,13 +207,7 @@ impl<F: ReducedForce> Modal<F> {
         };
         let newton_scale = scene.free_mass().sqrt() * scene.length_scale().max(f64::MIN_POSITIVE);
         let frequencies = modes.basis.frequencies();
-        let setup = ForceSetup {
-            loads,
-            options: force_options,
-            anchor_motion: options.anchor_motion,
-            omega_sq_bound: bound,
-            prebuilt: prebuilt.and_then(|d| d.cubature.as_ref()),
-        };
+        let setup = ForceSetup { loads, settings, omega_sq_bound: bound, prebuilt: prebuilt.and_then(|d| d.cubature.as_ref()) };
         let force = F::new(&scene, &modes, &setup)?;
         let omega_sq_bound = force.taut_bound(&scene, &modes).map_or(bound, |b| b.max(bound));
         let inv_mass = scene.dof_mass.iter().map(|m| 1.0 / m).collect();

@@ -1,0 +1,62 @@
+//! How a scene is integrated: every choice made at set-up, in one type.
+//!
+//! The enumerations are those of the variable table (`crate::options`,
+//! generated from `modelDescription/variables.toml`), so their items are
+//! defined once; this type gathers them with the numbers that go with them.
+
+pub use crate::options::{ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction};
+
+/// Everything the set-up of a [`super::Simulator`] chooses besides the scene and the loads.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// Space the equations live in (`docs/method.md`, sections 3 and 4).
+    pub reduction: Reduction,
+    /// Scheme of the internal steps (`docs/method.md`, section 4).
+    pub integrator: Integrator,
+    /// Modes kept by the modal space; in full space the number of modes
+    /// whose frequencies and coordinates are reported (0: none).
+    pub n_modes: usize,
+    /// Which modes the basis keeps: the lowest (the paper's) or those the
+    /// loads excite most (`docs/method.md`, section 3).
+    pub mode_selection: ModeSelection,
+    /// The static responses to the loads join the basis.
+    pub static_correction: bool,
+    /// Where the modes are computed: at rest (the paper's) or at the static
+    /// equilibrium under the set-up loads.
+    pub linearization: Linearization,
+    /// The anchor will move: its inertial load along each axis, M e_i, is
+    /// a load pattern of the basis and the cubature's training (`docs/method.md`, section 8).
+    pub anchor_motion: bool,
+    /// How the modal space evaluates the projected spring force: every
+    /// spring (the paper's) or a trained cubature (`docs/method.md`, section 4).
+    pub force_evaluation: ForceEvaluation,
+    /// With [`ForceEvaluation::Cubature`]: the relative error of Phi^T f on
+    /// the training and held-out poses the cubature set is grown to reach.
+    pub cubature_tolerance: f64,
+    /// Upper bound on one internal step [s].
+    pub max_internal_step: f64,
+    /// Split a communication step into internal steps that keep the
+    /// explicit integrator stable. Only tests switch this off, to show why it exists.
+    pub substepping: bool,
+}
+
+impl Settings {
+    /// `n_modes` modes, the given space and scheme, the paper's basis (the
+    /// lowest modes at rest, no correction) and forces (every spring),
+    /// internal steps of at most 10 ms.
+    pub fn new(reduction: Reduction, integrator: Integrator, n_modes: usize) -> Self {
+        Settings {
+            reduction,
+            integrator,
+            n_modes,
+            mode_selection: ModeSelection::Lowest,
+            static_correction: false,
+            linearization: Linearization::Rest,
+            anchor_motion: false,
+            force_evaluation: ForceEvaluation::Exact,
+            cubature_tolerance: 0.01,
+            max_internal_step: 0.01,
+            substepping: true,
+        }
+    }
+}
