@@ -9,7 +9,7 @@
 //!
 //! One force evaluation per step; stable while dt omega_max < 2 (undamped).
 
-use super::{predict, Buffers, Scheme, EXPLICIT_SAFETY};
+use super::scheme::{predict, Buffers, Scheme, EXPLICIT_SAFETY};
 use crate::physics::error::StepFailure;
 use crate::physics::space::Space;
 use crate::physics::state::{Loads, State};

@@ -11,7 +11,7 @@
 //! Unconditionally stable for the linear part; the Newton loop is the only
 //! one in the core, every space provides its J through [`Space::factor`].
 
-use super::{predict, Buffers, Scheme};
+use super::scheme::{predict, Buffers, Scheme};
 use crate::physics::error::StepFailure;
 use crate::physics::space::Space;
 use crate::physics::state::{Loads, State};

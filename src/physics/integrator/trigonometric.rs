@@ -37,7 +37,7 @@
 //! the step size differs (the first step, a change of loads or step size, a
 //! restored state) the step evaluates it first.
 
-use super::{Buffers, Scheme};
+use super::scheme::{Buffers, Scheme};
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::space::{Diagonal, Space};
 use crate::physics::state::{Loads, State};

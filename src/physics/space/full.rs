@@ -16,7 +16,7 @@ use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LdltRef, LltRe
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
-use super::{Diagonal, Space};
+use super::equations::{Diagonal, Space};
 use crate::physics::basis;
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::forces::{linearize, omega_sq_bound_full, SpringForces, SpringScratch, StiffnessPattern};

@@ -39,7 +39,7 @@ use ndarray::{Array1, Array2};
 use rand_chacha::rand_core::{RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::{ForceSetup, Modes, ReducedForce};
+use super::reduced::{ForceSetup, Modes, ReducedForce};
 use crate::physics::bake::SpringSet;
 use crate::physics::error::PhysicsError;
 use crate::physics::forces::{SpringForces, SpringScratch};
@@ -674,7 +674,7 @@ mod tests {
         };
         let built = basis::build(&scene, &loads, 6, &settings).unwrap();
         let modes = Modes::new(built.modes, built.point, built.at_rest);
-        let bound = super::super::taut_reduced_bound(&scene, &modes.basis).unwrap();
+        let bound = crate::physics::space::modal::reduced::taut_reduced_bound(&scene, &modes.basis).unwrap();
         let cub = Cubature::new(&scene, &modes, &ForceSetup { loads: &loads, settings: &settings, omega_sq_bound: bound, prebuilt: None }).unwrap();
         (scene, modes, cub)
     }

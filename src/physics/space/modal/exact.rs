@@ -3,7 +3,7 @@
 //! free DOFs, evaluate the exact forces of every spring, project them onto
 //! the kept modes. Its cost grows with the mesh, not with the modes.
 
-use super::{ForceSetup, Modes, ReducedForce};
+use super::reduced::{ForceSetup, Modes, ReducedForce};
 use crate::physics::error::PhysicsError;
 use crate::physics::forces::{add_reduced_tangent, SpringForces, SpringScratch};
 use crate::physics::scene::Scene;
