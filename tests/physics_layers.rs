@@ -97,7 +97,15 @@ fn use_paths(tree: &str) -> Vec<String> {
                 .into_iter()
                 .filter(|p| !p.trim().is_empty())
                 .flat_map(use_paths)
-                .map(|p| if p == "self" { prefix.to_string() } else if prefix.is_empty() { p } else { format!("{prefix}::{p}") })
+                .map(|p| {
+                    if p == "self" {
+                        prefix.to_string()
+                    } else if prefix.is_empty() {
+                        p
+                    } else {
+                        format!("{prefix}::{p}")
+                    }
+                })
                 .collect()
         }
     }

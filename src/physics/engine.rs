@@ -11,10 +11,11 @@ use std::marker::PhantomData;
 
 use super::bake::SetupData;
 use super::error::{PhysicsError, StepFailure};
+use super::forces::pull;
 use super::integrator::{Buffers, NewmarkExplicit, NewmarkImplicit, Scheme, Trigonometric};
 use super::scene::Scene;
 use super::settings::{ForceEvaluation, Integrator, Reduction, Settings};
-use super::space::{Cubature, Exact, Full, Modal, Space};
+use super::space::{Cubature, Exact, Full, Layout, Modal, Readout};
 use super::state::{Loads, State};
 
 /// The registry: builds the space `settings.reduction` names on `scene`
@@ -34,7 +35,7 @@ pub(crate) fn build(scene: Scene, settings: &Settings, loads: &Loads, prebuilt: 
 }
 
 /// Binds `space` to the scheme `kind` names.
-fn bind<S: Space>(space: S, kind: Integrator) -> Result<Box<dyn Stepper>, PhysicsError> {
+fn bind<S: Readout>(space: S, kind: Integrator) -> Result<Box<dyn Stepper>, PhysicsError> {
     Ok(match kind {
         Integrator::NewmarkExplicit => Box::new(Engine::<S, NewmarkExplicit>::new(space)?),
         Integrator::NewmarkImplicit => Box::new(Engine::<S, NewmarkImplicit>::new(space)?),
@@ -42,17 +43,12 @@ fn bind<S: Space>(space: S, kind: Integrator) -> Result<Box<dyn Stepper>, Physic
     })
 }
 
-/// What the simulator asks of a bound space and scheme.
-pub trait Stepper: Send {
+/// What the simulator asks of a bound space and scheme to step it; what it
+/// reads from it is [`Probe`].
+pub trait Stepper: Probe + Send {
     fn scene(&self) -> &Scene;
-    /// Number of generalized coordinates.
-    fn coordinates(&self) -> usize;
-    /// Modes kept (`None` in full space).
-    fn kept_modes(&self) -> Option<usize>;
-    /// Frequencies of the kept or reported modes [rad/s].
-    fn frequencies(&self) -> &[f64];
-    /// Springs one force evaluation visits.
-    fn springs(&self) -> usize;
+    /// Sizes and constants of the space.
+    fn layout(&self) -> Layout<'_>;
     /// The costly products of the set-up, as data (modal space only).
     fn setup_data(&self) -> Option<SetupData>;
     /// Longest stable internal step under `loads`, if stability limits it.
@@ -71,9 +67,6 @@ pub trait Stepper: Send {
     /// Evaluates the forces at `state.y` only (after a restore, which
     /// brings its own accelerations).
     fn evaluate(&mut self, loads: &Loads, state: &State);
-    /// The spring force at `y` in the space's coordinates (see
-    /// [`Space::spring_force`]); the forces at `state.y` are evaluated again after.
-    fn spring_force(&mut self, loads: &Loads, state: &State, y: &[f64], out: &mut [f64]);
     /// One internal step of length `dt`.
     fn step(&mut self, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure>;
     /// After the internal steps of a communication step: the forces
@@ -83,12 +76,20 @@ pub trait Stepper: Send {
     /// `state.v` (see [`Space::add_translation_rate`]) and sets `state.a`
     /// for the new rates (see [`Scheme::settle_rates`]).
     fn translate_rates(&mut self, loads: &Loads, c: &[f64; 3], state: &mut State);
+}
+
+/// What the simulator reads from a bound space at a state: the outputs,
+/// and the energies and momentum its checks weigh.
+pub trait Probe {
+    /// The spring force at `y` in the space's coordinates (see
+    /// [`Readout::spring_force`]); the forces at `state.y` are evaluated again after.
+    fn spring_force(&mut self, loads: &Loads, state: &State, y: &[f64], out: &mut [f64]);
     /// Momentum of the free nodes per axis, relative to the anchor [kg m/s].
     fn momentum(&self, state: &State) -> [f64; 3];
     /// Kinetic energy of `state` [J].
     fn kinetic_energy(&self, state: &State) -> f64;
     /// Potential energy of `state` as the force model sums it (see
-    /// [`Space::model_energy`]), for the step guard [J].
+    /// [`Readout::model_energy`]), for the step guard [J].
     fn model_energy(&mut self, loads: &Loads, state: &State) -> f64;
     /// Coordinates of the kept or reported modes.
     fn modal_coordinates(&self, state: &State, out: &mut [f64]);
@@ -150,7 +151,7 @@ impl Outputs {
 }
 
 /// Space `S` integrated by scheme `I`.
-pub struct Engine<S: Space, I: Scheme> {
+pub struct Engine<S: Readout, I: Scheme> {
     space: S,
     work: S::Work,
     buffers: Buffers,
@@ -160,13 +161,13 @@ pub struct Engine<S: Space, I: Scheme> {
     scheme: PhantomData<I>,
 }
 
-impl<S: Space, I: Scheme> Engine<S, I> {
+impl<S: Readout, I: Scheme> Engine<S, I> {
     /// Binds `space` to the scheme, or refuses a space the scheme cannot integrate.
     pub fn new(space: S) -> Result<Self, PhysicsError> {
         let anchors = anchor_springs(space.scene());
         let work = space.work();
         I::check(&space, &work)?;
-        Ok(Engine { work, buffers: Buffers::new(space.coordinates(), I::SCRATCH), anchors, space, scheme: PhantomData })
+        Ok(Engine { work, buffers: Buffers::new(space.layout().coordinates, I::SCRATCH), anchors, space, scheme: PhantomData })
     }
 }
 
@@ -190,45 +191,27 @@ fn anchor_springs(scene: &Scene) -> Vec<(usize, usize, f64, f64)> {
     anchors
 }
 
-/// Sum over `anchors` of the force each spring exerts on its held end at
-/// slot positions `x`: k (l - l0) (x_other - x_held) / l.
-fn anchor_force(anchors: &[(usize, usize, f64, f64)], d: usize, x: &[f64]) -> [f64; 3] {
+/// Sum over `anchors` of the force each spring exerts on its held end,
+/// with `at(slot)` the position of a slot ([`pull`] on the held end).
+fn anchor_force(anchors: &[(usize, usize, f64, f64)], d: usize, mut at: impl FnMut(usize) -> [f64; 3]) -> [f64; 3] {
     let mut f = [0.0; 3];
     for &(held, other, k, rest) in anchors {
-        let mut diff = [0.0; 3];
+        let (xh, xo) = (at(held), at(other));
+        let pulled = pull(&std::array::from_fn::<f64, 3, _>(|i| xo[i] - xh[i]), k, rest);
         for i in 0..d {
-            diff[i] = x[other * d + i] - x[held * d + i];
-        }
-        let l = diff.iter().map(|c| c * c).sum::<f64>().sqrt();
-        if l > 0.0 {
-            let t = k * (l - rest) / l;
-            for i in 0..d {
-                f[i] += t * diff[i];
-            }
+            f[i] += pulled[i];
         }
     }
     f
 }
 
-impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
+impl<S: Readout, I: Scheme> Stepper for Engine<S, I> {
     fn scene(&self) -> &Scene {
         self.space.scene()
     }
 
-    fn coordinates(&self) -> usize {
-        self.space.coordinates()
-    }
-
-    fn kept_modes(&self) -> Option<usize> {
-        self.space.kept_modes()
-    }
-
-    fn frequencies(&self) -> &[f64] {
-        self.space.frequencies()
-    }
-
-    fn springs(&self) -> usize {
-        self.space.springs()
+    fn layout(&self) -> Layout<'_> {
+        self.space.layout()
     }
 
     fn setup_data(&self) -> Option<SetupData> {
@@ -261,11 +244,6 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
         self.buffers.filter_step = f64::NAN;
     }
 
-    fn spring_force(&mut self, loads: &Loads, state: &State, y: &[f64], out: &mut [f64]) {
-        self.space.spring_force(y, &mut self.work, out);
-        self.evaluate(loads, state);
-    }
-
     fn step(&mut self, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure> {
         I::step(&self.space, &mut self.work, &mut self.buffers, loads, state, dt)
     }
@@ -277,6 +255,13 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
     fn translate_rates(&mut self, loads: &Loads, c: &[f64; 3], state: &mut State) {
         self.space.add_translation_rate(loads, c, &mut state.v);
         I::settle_rates(&self.space, &mut self.work, &mut self.buffers, loads, state);
+    }
+}
+
+impl<S: Readout, I: Scheme> Probe for Engine<S, I> {
+    fn spring_force(&mut self, loads: &Loads, state: &State, y: &[f64], out: &mut [f64]) {
+        self.space.spring_force(y, &mut self.work, out);
+        self.evaluate(loads, state);
     }
 
     fn momentum(&self, state: &State) -> [f64; 3] {
@@ -297,8 +282,8 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
 
     fn node_positions(&mut self, state: &State, out: &mut Outputs) {
         let scene = self.space.scene();
-        let x = self.space.positions(&state.y, &mut self.work);
-        out.anchor_force = anchor_force(&self.anchors, scene.dim, x);
+        let (d, x) = (scene.dim, self.space.positions(&state.y, &mut self.work));
+        out.anchor_force = anchor_force(&self.anchors, d, |slot| std::array::from_fn(|i| if i < d { x[slot * d + i] } else { 0.0 }));
         match scene.dim {
             2 => to_node_order::<2>(&scene.slot_of_node, usize::MAX, x, &mut out.positions),
             _ => to_node_order::<3>(&scene.slot_of_node, usize::MAX, x, &mut out.positions),
@@ -329,20 +314,8 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
     }
 
     fn anchor_force(&mut self, state: &State) -> [f64; 3] {
-        let d = self.space.scene().dim;
-        let mut f = [0.0; 3];
-        for &(held, other, k, rest) in &self.anchors {
-            let (xh, xo) = (self.space.slot_position(&state.y, held, &mut self.work), self.space.slot_position(&state.y, other, &mut self.work));
-            let diff: [f64; 3] = std::array::from_fn(|i| xo[i] - xh[i]);
-            let l = diff[..d].iter().map(|c| c * c).sum::<f64>().sqrt();
-            if l > 0.0 {
-                let t = k * (l - rest) / l;
-                for i in 0..d {
-                    f[i] += t * diff[i];
-                }
-            }
-        }
-        f
+        let (space, work) = (&self.space, &mut self.work);
+        anchor_force(&self.anchors, space.scene().dim, |slot| space.slot_position(&state.y, slot, work))
     }
 
     fn potential_energy(&mut self, loads: &Loads, state: &State) -> f64 {
@@ -353,7 +326,6 @@ impl<S: Space, I: Scheme> Stepper for Engine<S, I> {
         self.space.force_residual(loads, &state.y, &mut self.work)
     }
 }
-
 /// Slot-ordered values into node order, for the nodes whose slot is below
 /// `limit` (the free slots for velocities; every slot for positions); the
 /// other nodes get 0 (held nodes have no velocity of their own: the

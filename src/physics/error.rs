@@ -3,10 +3,8 @@
 //! Each error says which quantity is at fault, which limit it passed and,
 //! where there is one, what would lift it, in the terms of the physics
 //! (`docs/method.md`). The FMI layer (`crate::fmi::messages`) turns them
-//! into messages that name its variables; [`std::fmt::Display`] here is for
+//! into messages that name its variables; [`std::fmt::Display`] (thiserror) here is for
 //! users of the core alone (tests, benchmarks, the study).
-
-use std::fmt;
 
 use crate::options::Integrator;
 
@@ -74,103 +72,120 @@ impl Quantity {
 }
 
 /// What a refused value had to be.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
 pub enum Expected {
     /// Finite and > 0.
+    #[error("finite and positive")]
     Positive,
     /// Finite and >= 0.
+    #[error("finite and non-negative")]
     NonNegative,
     /// Finite.
+    #[error("finite")]
     Finite,
     /// 2 or 3.
+    #[error("2 or 3")]
     TwoOrThree,
     /// At least this value.
+    #[error("at least {0}")]
     AtLeast(f64),
     /// Above 0 and at most this value.
+    #[error("above 0 and at most {0}")]
     PositiveAtMost(f64),
-}
-
-impl fmt::Display for Expected {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Expected::Positive => f.write_str("finite and positive"),
-            Expected::NonNegative => f.write_str("finite and non-negative"),
-            Expected::Finite => f.write_str("finite"),
-            Expected::TwoOrThree => f.write_str("2 or 3"),
-            Expected::AtLeast(x) => write!(f, "at least {x}"),
-            Expected::PositiveAtMost(x) => write!(f, "above 0 and at most {x}"),
-        }
-    }
 }
 
 /// Why an internal step failed. The state is that of the start of the
 /// communication step whenever one of these is returned.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum StepFailure {
     /// A coordinate or rate became NaN or infinite.
+    #[error("the state became non-finite (internal step {dt:e} s); the integration diverged")]
     NonFinite { dt: f64 },
     /// Kinetic energy grew beyond what the loads could supply in one step.
+    #[error("kinetic energy grew to {kinetic:e} J from {before:e} J in one step (internal step {dt:e} s); the integration diverged")]
     EnergyGrowth { kinetic: f64, before: f64, dt: f64 },
     /// The Newton iteration of an implicit step did not converge.
+    #[error("implicit Newmark: Newton did not converge in {iterations} iterations at dt = {dt:e} s; shorten the internal steps")]
     NewtonNotConverged { iterations: usize, dt: f64 },
     /// The Newton matrix of an implicit step is singular.
+    #[error("implicit Newmark: singular Newton matrix at dt = {dt:e} s")]
     SingularNewton { dt: f64 },
     /// The full-space Newton matrix is singular even as LDL^T (springs in
     /// compression buckle).
+    #[error("the full-space Newmark matrix is singular (springs in compression buckle); shorten the internal steps")]
     Buckled,
     /// The trigonometric scheme: along the step, the part of the force
     /// beyond the modes' own springs changed as a stiffness `stiffness`
     /// [1/s^2] above `limit` = 4 / dt^2, beyond what its explicit kicks can
     /// follow (springs stretched or compressed far from rest stiffen modes
     /// whose own springs are soft).
+    #[error("trigonometric scheme: the force beyond the modes' own springs stiffened to {stiffness:.3e} 1/s^2 along the step, above the {limit:.3e} 1/s^2 its explicit part follows at dt = {dt:e} s; shorten the internal steps")]
     RestTooStiff { stiffness: f64, limit: f64, dt: f64 },
     /// The anchor's velocity changes by `speed` at the start of the step:
     /// the sheet would move relative to it by more than half the spacing in
     /// one internal step of `dt` (`docs/method.md`, section 8).
+    #[error("the anchor's velocity changes by {speed:e} m/s at the start of the step: the sheet would move relative to it by more than half the spacing per internal step of {dt:e} s (limit {limit:e} m/s); move the anchor more smoothly")]
     AnchorTooFast { speed: f64, limit: f64, dt: f64 },
 }
 
 /// An error of the physics core.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum PhysicsError {
     /// A quantity outside what the solver can run.
+    #[error("{} must be {expected}, got {value}", .quantity.describe())]
     Invalid { quantity: Quantity, value: f64, expected: Expected },
     /// An array of the wrong length.
+    #[error("{} has {len} values, expected {expected}", .quantity.describe())]
     Length { quantity: Quantity, len: usize, expected: usize },
     /// More nodes than the arrays can hold.
+    #[error("{nodes} nodes exceed the limit of {limit}")]
     TooManyNodes { nodes: f64, limit: usize },
     /// No node is free to move.
+    #[error("no node is free to move: the scene has no free degree of freedom")]
     NoFreeNode,
     /// More modes asked for than there are free degrees of freedom.
+    #[error("{modes} modes exceed the {dofs} free degrees of freedom of the scene")]
     ModesExceedDofs { modes: usize, dofs: usize },
     /// A dense eigen decomposition beyond its size limit.
+    #[error("{modes} modes need a dense eigen decomposition of the {dofs} free DOFs, above the limit of {limit}; keep at most {partial_max} modes (solved by the partial eigensolver), or integrate in full space")]
     DenseEigenTooLarge { modes: usize, dofs: usize, limit: usize, partial_max: usize },
     /// More modes than the partial eigensolver can find reliably.
+    #[error("{modes} modes are too many for the partial eigensolver on {coupled} coupled DOFs (at most 1/{fraction} of them)")]
     PartialTooManyModes { modes: usize, coupled: usize, fraction: usize },
     /// The partial eigensolver found fewer modes than asked for.
+    #[error("the partial eigensolver found {found} of the {modes} lowest modes; keep fewer modes or integrate in full space")]
     PartialIncomplete { found: usize, modes: usize },
     /// The modes asked for reach a repeated eigenvalue the partial solver
     /// cannot resolve.
+    #[error("the lowest {modes} modes reach a repeated eigenvalue ({lambda:.6e} 1/s^2), whose copies the partial eigensolver cannot all find; keep fewer modes (below the repeated one)")]
     RepeatedEigenvalue { modes: usize, lambda: f64 },
     /// The stiffness at the linearization point is not positive semi-definite.
+    #[error("the stiffness at the linearization point has a negative eigenvalue {lambda}")]
     NegativeEigenvalue { lambda: f64 },
     /// A factorization or eigen decomposition failed.
+    #[error("{what} failed: {detail}")]
     LinearAlgebra { what: &'static str, detail: String },
     /// No static equilibrium under the loads: Newton stopped at this
     /// fraction of the load, with this largest residual force relative to
     /// the largest load on a DOF.
+    #[error("no static equilibrium found under the loads: Newton reached {load_fraction} of the load with a residual of {residual:.2e} of the largest load; linearize at rest")]
     NoEquilibrium { load_fraction: f64, residual: f64 },
     /// Every equilibrium found is unstable (its stiffness has a negative eigenvalue).
+    #[error("every equilibrium found under the loads is unstable (its stiffness has a negative eigenvalue); linearize at rest")]
     UnstableEquilibrium,
     /// A basis built from the loads, and the loads are zero.
+    #[error("modes chosen by the loads, or a static correction, need a load at set-up, and gravity and the point load are zero")]
     NoLoad,
     /// A non-zero point load on a node that is held (`held`) or not in the
     /// scene (`node` is the node index asked for, if any).
+    #[error("the point load acts on node {node:?}, which is {}; choose a free node", if *.held { "held in place" } else { "not in the scene" })]
     LoadNode { node: Option<usize>, held: bool },
     /// The candidate vectors span fewer independent directions than asked for.
+    #[error("the basis has {found} independent vectors, {wanted} were asked for")]
     BasisDeficient { wanted: usize, found: usize },
     /// The explicit integrator would need more than `limit` internal steps
     /// per internal step bound: the scene is too stiff for it.
+    #[error("explicit Newmark is stable here only with internal steps of {stable_step:.3e} s (highest frequency {omega_max:.3e} rad/s of {}, stiffness / mass = {stiffness_per_mass:.3e} 1/s^2), {per_step:.2e} of them per internal step bound of {max_internal_step} s (limit {limit:e}): use implicit Newmark, fewer modes, or an internal step bound of {:.3e} s or less", kept(.modes), .stable_step * .limit)]
     ExplicitTooStiff {
         /// Largest stable internal step [s].
         stable_step: f64,
@@ -186,139 +201,44 @@ pub enum PhysicsError {
         modes: Option<usize>,
     },
     /// A communication step that would need more internal steps than one call may take.
+    #[error("a step of {h:e} s needs {steps:e} internal steps of at most {dt:e} s (limit {limit}); use the implicit integrator, fewer modes or a shorter communication step")]
     TooManyInternalSteps { h: f64, steps: f64, dt: f64, limit: usize },
     /// A communication step failed; the state is that of its start.
-    StepFailed { time: f64, cause: StepFailure },
+    #[error("step from t = {time} s failed: {cause}")]
+    StepFailed { time: f64, #[source] cause: StepFailure },
     /// The cubature set could not be grown to the tolerance within its
     /// size limit, or no spring left improves the fit.
+    #[error("the cubature reached a relative force error of {reached:.3e} with {springs} springs, its limit (at most 1000 and half the springs), or the fit stopped improving, short of half the tolerance {tolerance:e} (the training's margin); that tolerance needs exact forces")]
     CubatureNotReached { tolerance: f64, reached: f64, springs: usize },
     /// More modes than a cubature is trained for.
+    #[error("a cubature is trained for at most {limit} modes, {modes} are kept; keep fewer modes or use exact forces")]
     CubatureTooManyModes { modes: usize, limit: usize },
     /// The exact reduced run that makes the cubature's training poses diverged.
+    #[error("the exact reduced run that makes the cubature's training poses diverged at t = {time} s; use exact forces")]
     CubatureTrainingDiverged { time: f64 },
     /// Stored set-up data that does not fit the scene and solver.
+    #[error("the stored set-up data does not fit the scene and solver: {what}")]
     SetupDataMismatch { what: &'static str },
     /// The scheme integrates the linear oscillator of every coordinate
     /// exactly and needs a space whose linear part is diagonal (the modal
     /// space); the full space's stiffness and damping couple its coordinates.
+    #[error("the {} integrator integrates the linear oscillator of every mode exactly and needs the modal space; in full space the stiffness and the damping couple the coordinates", .scheme.name())]
     SchemeNeedsDiagonal { scheme: Integrator },
     /// A snapshot whose arrays do not fit this simulator.
+    #[error("the snapshot holds {len} state values, this simulator needs {expected}")]
     SnapshotLength { len: usize, expected: usize },
     /// A snapshot holding NaN or infinite values.
+    #[error("the snapshot holds non-finite values")]
     SnapshotNotFinite,
 }
 
-impl fmt::Display for StepFailure {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            StepFailure::NonFinite { dt } => write!(f, "the state became non-finite (internal step {dt:e} s); the integration diverged"),
-            StepFailure::EnergyGrowth { kinetic, before, dt } => {
-                write!(f, "kinetic energy grew to {kinetic:e} J from {before:e} J in one step (internal step {dt:e} s); the integration diverged")
-            }
-            StepFailure::NewtonNotConverged { iterations, dt } => {
-                write!(f, "implicit Newmark: Newton did not converge in {iterations} iterations at dt = {dt:e} s; shorten the internal steps")
-            }
-            StepFailure::SingularNewton { dt } => write!(f, "implicit Newmark: singular Newton matrix at dt = {dt:e} s"),
-            StepFailure::Buckled => f.write_str("the full-space Newmark matrix is singular (springs in compression buckle); shorten the internal steps"),
-            StepFailure::RestTooStiff { stiffness, limit, dt } => write!(
-                f,
-                "trigonometric scheme: the force beyond the modes' own springs stiffened to {stiffness:.3e} 1/s^2 along the step, \
-                 above the {limit:.3e} 1/s^2 its explicit part follows at dt = {dt:e} s; shorten the internal steps"
-            ),
-            StepFailure::AnchorTooFast { speed, limit, dt } => write!(
-                f,
-                "the anchor's velocity changes by {speed:e} m/s at the start of the step: the sheet would move relative to it by more \
-                 than half the spacing per internal step of {dt:e} s (limit {limit:e} m/s); move the anchor more smoothly"
-            ),
-        }
+/// The space of [`PhysicsError::ExplicitTooStiff`] in words.
+fn kept(modes: &Option<usize>) -> String {
+    match modes {
+        Some(r) => format!("the {r} kept modes"),
+        None => "full space".into(),
     }
 }
-
-impl fmt::Display for PhysicsError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        use PhysicsError::*;
-        match self {
-            Invalid { quantity, value, expected } => write!(f, "{} must be {expected}, got {value}", quantity.describe()),
-            Length { quantity, len, expected } => write!(f, "{} has {len} values, expected {expected}", quantity.describe()),
-            TooManyNodes { nodes, limit } => write!(f, "{nodes} nodes exceed the limit of {limit}"),
-            NoFreeNode => f.write_str("no node is free to move: the scene has no free degree of freedom"),
-            ModesExceedDofs { modes, dofs } => write!(f, "{modes} modes exceed the {dofs} free degrees of freedom of the scene"),
-            DenseEigenTooLarge { modes, dofs, limit, partial_max } => write!(
-                f,
-                "{modes} modes need a dense eigen decomposition of the {dofs} free DOFs, above the limit of {limit}; \
-                 keep at most {partial_max} modes (solved by the partial eigensolver), or integrate in full space"
-            ),
-            PartialTooManyModes { modes, coupled, fraction } => {
-                write!(f, "{modes} modes are too many for the partial eigensolver on {coupled} coupled DOFs (at most 1/{fraction} of them)")
-            }
-            PartialIncomplete { found, modes } => {
-                write!(f, "the partial eigensolver found {found} of the {modes} lowest modes; keep fewer modes or integrate in full space")
-            }
-            RepeatedEigenvalue { modes, lambda } => write!(
-                f,
-                "the lowest {modes} modes reach a repeated eigenvalue ({lambda:.6e} 1/s^2), whose copies the partial \
-                 eigensolver cannot all find; keep fewer modes (below the repeated one)"
-            ),
-            NegativeEigenvalue { lambda } => write!(f, "the stiffness at the linearization point has a negative eigenvalue {lambda}"),
-            LinearAlgebra { what, detail } => write!(f, "{what} failed: {detail}"),
-            NoEquilibrium { load_fraction, residual } => write!(
-                f,
-                "no static equilibrium found under the loads: Newton reached {load_fraction} of the load with a residual of \
-                 {residual:.2e} of the largest load; linearize at rest"
-            ),
-            CubatureNotReached { tolerance, reached, springs } => write!(
-                f,
-                "the cubature reached a relative force error of {reached:.3e} with {springs} springs, its limit (at most 1000 and half \
-                 the springs), or the fit stopped improving, short of half the tolerance {tolerance:e} (the training's margin); \
-                 that tolerance needs exact forces"
-            ),
-            CubatureTooManyModes { modes, limit } => {
-                write!(f, "a cubature is trained for at most {limit} modes, {modes} are kept; keep fewer modes or use exact forces")
-            }
-            CubatureTrainingDiverged { time } => {
-                write!(f, "the exact reduced run that makes the cubature's training poses diverged at t = {time} s; use exact forces")
-            }
-            SetupDataMismatch { what } => write!(f, "the stored set-up data does not fit the scene and solver: {what}"),
-            UnstableEquilibrium => {
-                f.write_str("every equilibrium found under the loads is unstable (its stiffness has a negative eigenvalue); linearize at rest")
-            }
-            NoLoad => f.write_str("modes chosen by the loads, or a static correction, need a load at set-up, and gravity and the point load are zero"),
-            LoadNode { node, held: true } => write!(f, "the point load acts on node {node:?}, which is held in place; choose a free node"),
-            LoadNode { node, held: false } => write!(f, "the point load acts on node {node:?}, which is not in the scene; choose a free node"),
-            BasisDeficient { wanted, found } => write!(f, "the basis has {found} independent vectors, {wanted} were asked for"),
-            ExplicitTooStiff { stable_step, omega_max, stiffness_per_mass, per_step, max_internal_step, limit, modes } => {
-                let kept = match modes {
-                    Some(r) => format!("the {r} kept modes"),
-                    None => "full space".into(),
-                };
-                write!(
-                    f,
-                    "explicit Newmark is stable here only with internal steps of {stable_step:.3e} s (highest frequency \
-                     {omega_max:.3e} rad/s of {kept}, stiffness / mass = {stiffness_per_mass:.3e} 1/s^2), {per_step:.2e} of them \
-                     per internal step bound of {max_internal_step} s (limit {limit:e}): use implicit Newmark, fewer modes, \
-                     or an internal step bound of {:.3e} s or less",
-                    stable_step * limit
-                )
-            }
-            TooManyInternalSteps { h, steps, dt, limit } => write!(
-                f,
-                "a step of {h:e} s needs {steps:e} internal steps of at most {dt:e} s (limit {limit}); \
-                 use the implicit integrator, fewer modes or a shorter communication step"
-            ),
-            StepFailed { time, cause } => write!(f, "step from t = {time} s failed: {cause}"),
-            SchemeNeedsDiagonal { scheme } => write!(
-                f,
-                "the {} integrator integrates the linear oscillator of every mode exactly and needs the modal space; \
-                 in full space the stiffness and the damping couple the coordinates",
-                scheme.name()
-            ),
-            SnapshotLength { len, expected } => write!(f, "the snapshot holds {len} state values, this simulator needs {expected}"),
-            SnapshotNotFinite => f.write_str("the snapshot holds non-finite values"),
-        }
-    }
-}
-
-impl std::error::Error for PhysicsError {}
 
 /// Refuses `value` unless it is finite and positive.
 pub fn positive(quantity: Quantity, value: f64) -> Result<(), PhysicsError> {

@@ -158,19 +158,40 @@ pub fn elastic_energy(scene: &Scene, x: &[f64]) -> f64 {
         .sum()
 }
 
-/// Tangent stiffness block of one spring, K_e = k [ u u^T + (1 - l0/l)(I - u u^T) ]
-/// (`docs/method.md`, section 2). `taut` replaces it by its bound k I (every
-/// direction as stiff as the axis), used for step-size limits.
+/// The force of one spring on its end a, k (l - l0) / l d, for the spring
+/// vector d = x_b - x_a of length l (`docs/method.md`, section 2); 0 for a
+/// spring of zero length, whose direction is undefined. The spring loop of
+/// [`SpringForces::add_to`] computes the same, lane by lane.
+#[inline]
+pub fn pull<const D: usize>(d: &[f64; D], k: f64, l0: f64) -> [f64; D] {
+    let l = d.iter().map(|c| c * c).sum::<f64>().sqrt();
+    if l > 0.0 {
+        let t = k * (l - l0) / l;
+        d.map(|c| t * c)
+    } else {
+        [0.0; D]
+    }
+}
+
+/// Tangent stiffness block of one spring with vector d, K_e = k [ u u^T + (1 - l0/l)(I - u u^T) ],
+/// u = d / l (`docs/method.md`, section 2).
+#[inline]
+pub fn block<const D: usize>(d: &[f64; D], k: f64, l0: f64) -> SMatrix<f64, D, D> {
+    let d = SVector::<f64, D>::from(*d);
+    let l = d.norm();
+    let geo = 1.0 - l0 / l;
+    // k [ (1 - geo) u u^T + geo I ] with u u^T = d d^T / l^2, entry by entry
+    SMatrix::from_fn(|i, j| k * ((1.0 - geo) * (d[i] * d[j] / (l * l)) + if i == j { geo } else { 0.0 }))
+}
+
+/// [`block`] of spring `s` at slot positions `x`. `taut` replaces it by its
+/// bound k I (every direction as stiff as the axis), used for step-size limits.
 #[inline]
 pub fn spring_block<const D: usize>(s: &Spring, x: &[f64], taut: bool) -> SMatrix<f64, D, D> {
     if taut {
         return SMatrix::from_diagonal_element(s.k);
     }
-    let d = SVector::<f64, D>::from_fn(|i, _| x[s.b * D + i] - x[s.a * D + i]);
-    let l = d.norm();
-    let geo = 1.0 - s.rest / l;
-    // k [ (1 - geo) u u^T + geo I ] with u u^T = d d^T / l^2, entry by entry
-    SMatrix::from_fn(|i, j| s.k * ((1.0 - geo) * (d[i] * d[j] / (l * l)) + if i == j { geo } else { 0.0 }))
+    block(&std::array::from_fn(|i| x[s.b * D + i] - x[s.a * D + i]), s.k, s.rest)
 }
 
 /// The `D` coordinates of slot `slot` in a flat array.

@@ -102,7 +102,7 @@ impl Simulator {
         let dim = scene.dim;
         let mut engine = engine::build(scene, settings, loads, prebuilt)?;
         engine.apply_loads(loads);
-        let mut state = State::at_rest(engine.coordinates());
+        let mut state = State::at_rest(engine.layout().coordinates);
         engine.rest_coordinates(&mut state.y);
         // The sheet starts at rest wherever the anchor is.
         state.anchor[..dim].copy_from_slice(&loads.anchor[..dim]);
@@ -145,7 +145,7 @@ impl Simulator {
             per_step,
             max_internal_step: self.settings.max_internal_step,
             limit: MAX_STABLE_SUBSTEPS,
-            modes: self.engine.kept_modes(),
+            modes: self.engine.layout().kept_modes,
         })
     }
 
@@ -315,7 +315,7 @@ impl Simulator {
     }
     /// omega_i of the kept or reported modes, ascending [rad/s].
     pub fn mode_frequencies(&self) -> &[f64] {
-        self.engine.frequencies()
+        self.engine.layout().frequencies
     }
     /// The spring force at generalized coordinates `y` as the space
     /// evaluates it: Phi^T f(x* + Phi y) in the modal space (every spring,
@@ -337,7 +337,7 @@ impl Simulator {
     }
     /// Springs one force evaluation visits: every spring, or the cubature set.
     pub fn cubature_springs(&self) -> usize {
-        self.engine.springs()
+        self.engine.layout().springs
     }
     /// 1/2 v^T M v [J].
     pub fn kinetic_energy(&self) -> f64 {

@@ -51,7 +51,7 @@ impl Scheme for NewmarkImplicit {
             for (y, d) in buf.y1.iter_mut().zip(&buf.r) {
                 *y += d;
             }
-            done = converged(&buf.r, &buf.y1, space.newton_scale());
+            done = converged(&buf.r, &buf.y1, space.layout().newton_scale);
         }
         Err(StepFailure::NewtonNotConverged { iterations: MAX_NEWTON_ITERATIONS, dt })
     }

@@ -22,27 +22,37 @@ pub struct Diagonal<'a> {
     pub load: &'a [f64],
 }
 
-/// The equations of one space; see the module documentation.
+/// Sizes and constants of a space, fixed at set-up.
+#[derive(Clone, Copy, Debug)]
+pub struct Layout<'a> {
+    /// The scene the space was built on.
+    pub scene: &'a Scene,
+    /// Number of generalized coordinates.
+    pub coordinates: usize,
+    /// Modes kept (`None` in full space, where every DOF is integrated).
+    pub kept_modes: Option<usize>,
+    /// Springs one force evaluation visits.
+    pub springs: usize,
+    /// Angular frequencies of the kept or reported modes at the linearization point, ascending [rad/s].
+    pub frequencies: &'a [f64],
+    /// Scale of y below which Newton updates count as converged.
+    pub newton_scale: f64,
+}
+
+/// The equations of one space, as the schemes step them; see the module
+/// documentation. What is read from its coordinates is [`Readout`].
 pub trait Space: Send + Sized + 'static {
     /// Load terms and scratch of one run.
     type Work: Send + 'static;
 
     /// The scene the space was built on.
     fn scene(&self) -> &Scene;
-    /// Number of generalized coordinates.
-    fn coordinates(&self) -> usize;
-    /// Modes kept (`None` in full space, where every DOF is integrated).
-    fn kept_modes(&self) -> Option<usize>;
-    /// Springs one force evaluation visits.
-    fn springs(&self) -> usize {
-        self.scene().springs.len()
-    }
+    /// Sizes and constants of the space.
+    fn layout(&self) -> Layout<'_>;
     /// The costly products of the set-up, as data (modal space only).
     fn setup_data(&self) -> Option<SetupData> {
         None
     }
-    /// Angular frequencies of the kept or reported modes at the linearization point, ascending [rad/s].
-    fn frequencies(&self) -> &[f64];
     /// Fresh load terms (all zero) and scratch.
     fn work(&self) -> Self::Work;
     /// The coordinates of the scene at rest, where every run starts (0
@@ -52,10 +62,6 @@ pub trait Space: Send + Sized + 'static {
     /// Derives the load terms (damping per coordinate, generalized gravity
     /// and point load) from `loads`, once per load change.
     fn apply_loads(&self, loads: &Loads, w: &mut Self::Work);
-    /// The spring force alone in the space's coordinates (Phi^T f(x) in
-    /// the modal space, as its force model evaluates it; f(x) in full space),
-    /// for diagnostics: it overwrites what the last [`Space::force`] left in `w`.
-    fn spring_force(&self, y: &[f64], w: &mut Self::Work, out: &mut [f64]);
     /// h(y) into `h`; leaves the slot positions and the elastic energy at y in `w`.
     fn force(&self, loads: &Loads, y: &[f64], w: &mut Self::Work, h: &mut [f64]);
     /// The velocity update of explicit Newmark: v1 from
@@ -70,8 +76,6 @@ pub trait Space: Send + Sized + 'static {
     fn factor(&self, loads: &Loads, c_m: f64, c_c: f64, w: &mut Self::Work) -> Result<(), StepFailure>;
     /// Solves with the last [`Space::factor`], in place.
     fn solve(&self, w: &mut Self::Work, rhs: &mut [f64]);
-    /// Scale of y below which Newton updates count as converged.
-    fn newton_scale(&self) -> f64;
     /// Upper bound on the squared frequencies of the integrated system
     /// under `loads`, in any state where no spring is compressed [1/s^2].
     fn omega_sq_bound(&self, loads: &Loads) -> f64;
@@ -82,6 +86,21 @@ pub trait Space: Send + Sized + 'static {
     /// the linear part couples the coordinates (full space). The weights act
     /// on g alone: g_i = h_i + lambda_i y_i is w_i r_i (`docs/method.md`, section 3).
     fn diagonal<'a>(&'a self, w: &'a Self::Work) -> Option<Diagonal<'a>>;
+    /// Adds to the rates `v` those of a rigid translation of every free
+    /// node with velocity `c` (z is 0 in 2D), each coordinate scaled by its
+    /// weight like a load: the velocity kick of an anchor whose velocity
+    /// changes by -c (`docs/method.md`, section 8).
+    fn add_translation_rate(&self, loads: &Loads, c: &[f64; 3], v: &mut [f64]);
+}
+
+/// What is read from a space's coordinates: positions, velocities,
+/// energies, momentum and the force it cannot represent (relative to the
+/// anchor).
+pub trait Readout: Space {
+    /// The spring force alone in the space's coordinates (Phi^T f(x) in
+    /// the modal space, as its force model evaluates it; f(x) in full space),
+    /// for diagnostics: it overwrites what the last [`Space::force`] left in `w`.
+    fn spring_force(&self, y: &[f64], w: &mut Self::Work, out: &mut [f64]);
 
     /// Slot positions at y, the coordinates of the last [`Space::force`].
     fn positions<'w>(&self, y: &[f64], w: &'w mut Self::Work) -> &'w [f64];
@@ -110,11 +129,6 @@ pub trait Space: Send + Sized + 'static {
     }
     /// 1/2 v^T M v in physical space [J].
     fn kinetic_energy(&self, v: &[f64]) -> f64;
-    /// Adds to the rates `v` those of a rigid translation of every free
-    /// node with velocity `c` (z is 0 in 2D), each coordinate scaled by its
-    /// weight like a load: the velocity kick of an anchor whose velocity
-    /// changes by -c (`docs/method.md`, section 8).
-    fn add_translation_rate(&self, loads: &Loads, c: &[f64; 3], v: &mut [f64]);
     /// Momentum of the free nodes per axis, sum_k m_k v_k, at rates `v` [kg m/s].
     fn momentum(&self, v: &[f64]) -> [f64; 3];
     /// Velocities of the free DOFs.

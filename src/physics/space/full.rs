@@ -16,7 +16,7 @@ use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LdltRef, LltRe
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
-use super::equations::{Diagonal, Space};
+use super::equations::{Diagonal, Layout, Readout, Space};
 use crate::physics::basis;
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::forces::{linearize, omega_sq_bound_full, SpringForces, SpringScratch, StiffnessPattern};
@@ -150,16 +150,15 @@ impl Space for Full {
         &self.scene
     }
 
-    fn coordinates(&self) -> usize {
-        self.scene.n_dofs()
-    }
-
-    fn kept_modes(&self) -> Option<usize> {
-        None
-    }
-
-    fn frequencies(&self) -> &[f64] {
-        &self.frequencies
+    fn layout(&self) -> Layout<'_> {
+        Layout {
+            scene: &self.scene,
+            coordinates: self.scene.n_dofs(),
+            kept_modes: None,
+            springs: self.scene.springs.len(),
+            frequencies: &self.frequencies,
+            newton_scale: self.newton_scale,
+        }
     }
 
     fn work(&self) -> FullWork {
@@ -212,14 +211,6 @@ impl Space for Full {
         }
         h.copy_from_slice(&w.gravity);
         w.elastic = self.springs.add_to(&self.scene, &w.x, &mut w.springs, h);
-    }
-
-    fn spring_force(&self, u: &[f64], w: &mut FullWork, out: &mut [f64]) {
-        for k in 0..u.len() {
-            w.x[k] = self.scene.rest[k] + u[k];
-        }
-        out.fill(0.0);
-        w.elastic = self.springs.add_to(&self.scene, &w.x, &mut w.springs, out);
     }
 
     fn explicit_velocity(&self, dt: f64, v: &[f64], a: &[f64], h: &[f64], w: &mut FullWork, v1: &mut [f64]) -> Result<(), StepFailure> {
@@ -275,10 +266,6 @@ impl Space for Full {
         }
     }
 
-    fn newton_scale(&self) -> f64 {
-        self.newton_scale
-    }
-
     fn omega_sq_bound(&self, _loads: &Loads) -> f64 {
         self.omega_sq_bound
     }
@@ -286,6 +273,24 @@ impl Space for Full {
     /// K0 and C couple the DOFs: no diagonal form.
     fn diagonal<'a>(&'a self, _w: &'a FullWork) -> Option<Diagonal<'a>> {
         None
+    }
+
+    /// u' += 1 c on every free node.
+    fn add_translation_rate(&self, _loads: &Loads, c: &[f64; 3], v: &mut [f64]) {
+        let d = self.scene.dim;
+        for (k, vk) in v.iter_mut().enumerate() {
+            *vk += c[k % d];
+        }
+    }
+}
+
+impl Readout for Full {
+    fn spring_force(&self, u: &[f64], w: &mut FullWork, out: &mut [f64]) {
+        for k in 0..u.len() {
+            w.x[k] = self.scene.rest[k] + u[k];
+        }
+        out.fill(0.0);
+        w.elastic = self.springs.add_to(&self.scene, &w.x, &mut w.springs, out);
     }
 
     fn positions<'w>(&self, _u: &[f64], w: &'w mut FullWork) -> &'w [f64] {
@@ -309,14 +314,6 @@ impl Space for Full {
 
     fn kinetic_energy(&self, v: &[f64]) -> f64 {
         0.5 * v.iter().zip(&self.scene.dof_mass).map(|(v, m)| m * v * v).sum::<f64>()
-    }
-
-    /// u' += 1 c on every free node.
-    fn add_translation_rate(&self, _loads: &Loads, c: &[f64; 3], v: &mut [f64]) {
-        let d = self.scene.dim;
-        for (k, vk) in v.iter_mut().enumerate() {
-            *vk += c[k % d];
-        }
     }
 
     fn slot_velocity(&self, v: &[f64], slot: usize) -> [f64; 3] {

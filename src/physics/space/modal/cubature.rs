@@ -42,7 +42,7 @@ use rand_chacha::ChaCha8Rng;
 use super::reduced::{ForceSetup, Modes, ReducedForce};
 use crate::physics::bake::SpringSet;
 use crate::physics::error::PhysicsError;
-use crate::physics::forces::{SpringForces, SpringScratch};
+use crate::physics::forces::{block, pull, SpringForces, SpringScratch};
 use crate::physics::scene::Scene;
 
 /// Poses sampled along the training run (half train, half held out).
@@ -237,12 +237,10 @@ impl Cubature {
                 dv[i] = d0[i] - g[i * r..(i + 1) * r].iter().zip(q).map(|(a, b)| a * b).sum::<f64>();
             }
             d.copy_from_slice(&dv);
-            let l = dv.iter().map(|c| c * c).sum::<f64>().sqrt();
-            let t = wk * (l - l0) / l;
+            let gv = pull(&dv, wk, l0);
             for i in 0..D {
-                let gi = t * dv[i];
                 for (o, gij) in out.iter_mut().zip(&g[i * r..(i + 1) * r]) {
-                    *o += gij * gi;
+                    *o += gij * gv[i];
                 }
             }
         }
@@ -255,7 +253,7 @@ impl Cubature {
             let ke = block::<D>(d.try_into().expect("D values"), wk, l0);
             for i in 0..D {
                 for j in 0..r {
-                    kg[i * r + j] = (0..D).map(|m| ke[i][m] * g[m * r + j]).sum();
+                    kg[i * r + j] = (0..D).map(|m| ke[(i, m)] * g[m * r + j]).sum();
                 }
             }
             for col in 0..r {
@@ -265,20 +263,6 @@ impl Cubature {
             }
         }
     }
-}
-
-/// k [ u u^T + (1 - l0/l)(I - u u^T) ] for the spring vector d (`docs/method.md`, section 2).
-fn block<const D: usize>(d: &[f64; D], k: f64, l0: f64) -> [[f64; D]; D] {
-    let l2: f64 = d.iter().map(|c| c * c).sum();
-    let geo = 1.0 - l0 / l2.sqrt();
-    std::array::from_fn(|i| std::array::from_fn(|j| k * ((1.0 - geo) * d[i] * d[j] / l2 + if i == j { geo } else { 0.0 })))
-}
-
-/// k (l - l0) / l d: the force of a spring on its end a.
-fn spring_force<const D: usize>(d: &[f64; D], k: f64, l0: f64) -> [f64; D] {
-    let l = d.iter().map(|c| c * c).sum::<f64>().sqrt();
-    let t = k * (l - l0) / l;
-    d.map(|c| t * c)
 }
 
 /// Uniform in [0, 1) from the seeded stream.
@@ -315,14 +299,14 @@ impl<const D: usize> Candidate<D> {
             return None;
         }
         let d0: [f64; D] = std::array::from_fn(|i| modes.point[s.b * D + i] - modes.point[s.a * D + i]);
-        Some(Candidate { index: e, f0: spring_force(&d0, s.k, s.rest), g, d0, k: s.k, l0: s.rest })
+        Some(Candidate { index: e, f0: pull(&d0, s.k, s.rest), g, d0, k: s.k, l0: s.rest })
     }
 
     /// p_e(q_t) - p_e(0) for every pose (r values each): G^T [g(d0 - G q) - g(d0)].
     fn column(&self, r: usize, poses: &[Vec<f64>], out: &mut [f64]) {
         for (q, o) in poses.iter().zip(out.chunks_exact_mut(r)) {
             let d: [f64; D] = std::array::from_fn(|i| self.d0[i] - self.g[i * r..(i + 1) * r].iter().zip(q).map(|(a, b)| a * b).sum::<f64>());
-            let f = spring_force(&d, self.k, self.l0);
+            let f = pull(&d, self.k, self.l0);
             let v: [f64; D] = std::array::from_fn(|i| f[i] - self.f0[i]);
             o.fill(0.0);
             for i in 0..D {

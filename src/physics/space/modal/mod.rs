@@ -28,7 +28,7 @@ pub use cubature::Cubature;
 pub use exact::Exact;
 pub use reduced::{taut_reduced_bound, ForceSetup, Modes, ReducedForce};
 
-use super::equations::{Diagonal, Space};
+use super::equations::{Diagonal, Layout, Readout, Space};
 use crate::physics::bake::SetupData;
 use crate::physics::basis;
 use crate::physics::error::{PhysicsError, StepFailure};
@@ -134,16 +134,15 @@ impl<F: ReducedForce> Space for Modal<F> {
         &self.scene
     }
 
-    fn coordinates(&self) -> usize {
-        self.modes.basis.r
-    }
-
-    fn kept_modes(&self) -> Option<usize> {
-        Some(self.modes.basis.r)
-    }
-
-    fn springs(&self) -> usize {
-        self.force.springs(&self.scene)
+    fn layout(&self) -> Layout<'_> {
+        Layout {
+            scene: &self.scene,
+            coordinates: self.modes.basis.r,
+            kept_modes: Some(self.modes.basis.r),
+            springs: self.force.springs(&self.scene),
+            frequencies: &self.frequencies,
+            newton_scale: self.newton_scale,
+        }
     }
 
     fn setup_data(&self) -> Option<SetupData> {
@@ -154,10 +153,6 @@ impl<F: ReducedForce> Space for Modal<F> {
             omega_sq_bound: self.bound,
             cubature: self.force.spring_set(),
         })
-    }
-
-    fn frequencies(&self) -> &[f64] {
-        &self.frequencies
     }
 
     fn work(&self) -> ModalWork<F::Work> {
@@ -226,10 +221,6 @@ impl<F: ReducedForce> Space for Modal<F> {
         }
     }
 
-    fn spring_force(&self, q: &[f64], w: &mut Self::Work, out: &mut [f64]) {
-        self.force.project(&self.scene, &self.modes, q, &mut w.force, out);
-    }
-
     fn force(&self, loads: &Loads, q: &[f64], w: &mut Self::Work, h: &mut [f64]) {
         // F = Phi^T (f + M g)
         self.force.project(&self.scene, &self.modes, q, &mut w.force, h);
@@ -288,10 +279,6 @@ impl<F: ReducedForce> Space for Modal<F> {
         solve_in_place_with_conj(jac, jac, row_perm, Conj::No, MatMut::from_column_major_slice_mut(rhs, r, 1), Par::Seq, stack);
     }
 
-    fn newton_scale(&self) -> f64 {
-        self.newton_scale
-    }
-
     /// Weights above 1 scale the stiffness each mode sees beyond its own.
     fn omega_sq_bound(&self, loads: &Loads) -> f64 {
         loads.weight_max() * self.omega_sq_bound
@@ -301,6 +288,20 @@ impl<F: ReducedForce> Space for Modal<F> {
     /// and the weighted generalized load w_i (Phi^T (M g + f_p))_i.
     fn diagonal<'a>(&'a self, w: &'a Self::Work) -> Option<Diagonal<'a>> {
         Some(Diagonal { stiffness: &self.modes.basis.lambda, damping: &w.damping, load: &w.weighted_load })
+    }
+
+    /// q' += w_i Phi^T M (1 c): a rigid velocity c of the free nodes,
+    /// projected and weighted like every load.
+    fn add_translation_rate(&self, loads: &Loads, c: &[f64; 3], v: &mut [f64]) {
+        for (j, (vj, t)) in v.iter_mut().zip(self.translation.chunks_exact(3)).enumerate() {
+            *vj += loads.mode_weights[j] * (t[0] * c[0] + t[1] * c[1] + t[2] * c[2]);
+        }
+    }
+}
+
+impl<F: ReducedForce> Readout for Modal<F> {
+    fn spring_force(&self, q: &[f64], w: &mut Self::Work, out: &mut [f64]) {
+        self.force.project(&self.scene, &self.modes, q, &mut w.force, out);
     }
 
     fn positions<'w>(&self, q: &[f64], w: &'w mut Self::Work) -> &'w [f64] {
@@ -363,14 +364,6 @@ impl<F: ReducedForce> Space for Modal<F> {
         0.5 * v.iter().map(|v| v * v).sum::<f64>()
     }
 
-    /// q' += w_i Phi^T M (1 c): a rigid velocity c of the free nodes,
-    /// projected and weighted like every load.
-    fn add_translation_rate(&self, loads: &Loads, c: &[f64; 3], v: &mut [f64]) {
-        for (j, (vj, t)) in v.iter_mut().zip(self.translation.chunks_exact(3)).enumerate() {
-            *vj += loads.mode_weights[j] * (t[0] * c[0] + t[1] * c[1] + t[2] * c[2]);
-        }
-    }
-
     /// x* + Phi q at one slot, summed mode by mode as [`Modes::expand`] does
     /// (the same bits), without expanding the others; held slots stay at x*.
     fn slot_position(&self, q: &[f64], slot: usize, _w: &mut Self::Work) -> [f64; 3] {
@@ -421,7 +414,6 @@ impl<F: ReducedForce> Space for Modal<F> {
         out.copy_from_slice(q);
     }
 }
-
 /// Stored set-up data fits `scene` and `n_modes`: sizes, finite values, unit-mass modes are not re-checked
 /// (the data is what a set-up of the same parameters wrote).
 fn check_prebuilt(scene: &Scene, n_modes: usize, data: &SetupData) -> Result<(), PhysicsError> {
