@@ -86,42 +86,60 @@ def test_random_trajectories_agree_with_rust(rust_error, tmp_path, seed, frames,
     assert worst == pytest.approx(worst_rs, rel=RTOL, abs=0.0)
 
 
-def test_unequal_masses_agree_with_rust(rust_error, tmp_path):
-    """Masses weigh each node's squared distance; a heavy node's error counts
-    more, so E moves away from the equal-mass E (which cancels any common mass)."""
+def unequal_masses_case():
     nodes, dim = 40, 3
     run, reference, start = random_case(5, 60, nodes, dim)
     masses = np.random.default_rng(6).uniform(0.2, 5.0, nodes)
-    e = trajectory_error(run, reference, start, dim, masses=masses)
-    e_rs, worst_rs = rust_measures(rust_error, tmp_path, run, reference, start, dim, masses)
-    assert e == pytest.approx(e_rs, rel=RTOL, abs=0.0)
-    assert max_node_error(run, reference, dim) == pytest.approx(worst_rs, rel=RTOL, abs=0.0)
-    equal = trajectory_error(run, reference, start, dim)
+    return run, reference, start, dim, masses
+
+
+def test_masses_weigh_the_nodes():
+    """Masses weigh each node's squared distance: a heavy node's error counts
+    more, so E moves away from the equal-mass E, which any common mass leaves
+    as it is."""
+    run, reference, start, dim, masses = unequal_masses_case()
+    e, equal = trajectory_error(run, reference, start, dim, masses=masses), trajectory_error(run, reference, start, dim)
     assert abs(e - equal) > 1e-3 * equal, (e, equal)
-    assert trajectory_error(run, reference, start, dim, masses=np.full(nodes, 2.5)) == pytest.approx(equal, rel=1e-14)
+    assert trajectory_error(run, reference, start, dim, masses=np.full(len(masses), 2.5)) == pytest.approx(equal, rel=1e-14)
 
 
-@pytest.mark.parametrize("masses", [None, "unequal"])
-def test_known_error_of_an_offset_run(rust_error, tmp_path, masses):
+def test_unequal_masses_agree_with_rust(rust_error, tmp_path):
+    run, reference, start, dim, masses = unequal_masses_case()
+    e_rs, worst_rs = rust_measures(rust_error, tmp_path, run, reference, start, dim, masses)
+    assert trajectory_error(run, reference, start, dim, masses=masses) == pytest.approx(e_rs, rel=RTOL, abs=0.0)
+    assert max_node_error(run, reference, dim) == pytest.approx(worst_rs, rel=RTOL, abs=0.0)
+
+
+def offset_case(masses):
     """A reference whose every node moves from x_i(0) with the velocity v and
     a run offset from it by the constant vector c at every output time t_k:
 
         E = sqrt(Σ_k Σ_i m_i |c|²) / sqrt(Σ_k Σ_i m_i t_k² |v|²) = |c| sqrt(K) / (|v| sqrt(Σ_k t_k²)),
 
-    whatever the masses, and every node is |c| from its reference position."""
+    whatever the masses, and every node is |c| from its reference position.
+    Returns (run, reference, start, D, masses, E, largest node error)."""
     nodes, dim, t = 7, 3, np.linspace(0.0, 2.0, 21)
     v, c = np.array([0.3, -1.2, 0.4]), np.array([1e-3, 2e-3, -2e-3])
     start = np.random.default_rng(7).uniform(-1.0, 1.0, (nodes, dim))
     reference = start[None] + t[:, None, None] * v
-    run = reference + c
     m = np.random.default_rng(8).uniform(0.5, 2.0, nodes) if masses else None
-    expected = np.linalg.norm(c) * math.sqrt(len(t)) / (np.linalg.norm(v) * math.sqrt((t**2).sum()))
-    e, worst = trajectory_error(run, reference, start, dim, masses=m), max_node_error(run, reference, dim)
-    assert e == pytest.approx(expected, rel=RTOL, abs=0.0)
-    assert worst == pytest.approx(np.linalg.norm(c), rel=RTOL, abs=0.0)
-    e_rs, worst_rs = rust_measures(rust_error, tmp_path, run, reference, start.ravel(), dim, m)
-    assert e_rs == pytest.approx(expected, rel=RTOL, abs=0.0)
-    assert worst_rs == pytest.approx(np.linalg.norm(c), rel=RTOL, abs=0.0)
+    e = np.linalg.norm(c) * math.sqrt(len(t)) / (np.linalg.norm(v) * math.sqrt((t**2).sum()))
+    return reference + c, reference, start.ravel(), dim, m, e, np.linalg.norm(c)
+
+
+@pytest.mark.parametrize("masses", [False, True], ids=["equal", "unequal"])
+def test_known_error_of_an_offset_run(masses):
+    run, reference, start, dim, m, e, worst = offset_case(masses)
+    assert trajectory_error(run, reference, start, dim, masses=m) == pytest.approx(e, rel=RTOL, abs=0.0)
+    assert max_node_error(run, reference, dim) == pytest.approx(worst, rel=RTOL, abs=0.0)
+
+
+@pytest.mark.parametrize("masses", [False, True], ids=["equal", "unequal"])
+def test_known_error_of_an_offset_run_in_rust(rust_error, tmp_path, masses):
+    run, reference, start, dim, m, e, worst = offset_case(masses)
+    e_rs, worst_rs = rust_measures(rust_error, tmp_path, run, reference, start, dim, m)
+    assert e_rs == pytest.approx(e, rel=RTOL, abs=0.0)
+    assert worst_rs == pytest.approx(worst, rel=RTOL, abs=0.0)
 
 
 def test_error_shapes_and_zero():
