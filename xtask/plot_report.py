@@ -6,6 +6,7 @@ the largest forceResidual of each modal run (coloured by variant; Spearman's
 rank correlation in the title). force_residual.png: E against the largest and
 the mean forceResidual of the leave-out runs of every scene."""
 import csv
+import os
 import sys
 from collections import defaultdict
 
@@ -14,6 +15,10 @@ import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+
+# Spearman's rank correlation from the repository's one Python copy of the measures.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "python"))
+from measures import spearman  # noqa: E402
 
 rows = list(csv.DictReader(open(sys.argv[1])))
 out = sys.argv[2]
@@ -43,26 +48,6 @@ def f(r, column):
         return float(r.get(column) or "nan")
     except ValueError:
         return float("nan")
-
-
-def spearman(x, y):
-    """Spearman's rank correlation (ties share their mean rank), numpy only."""
-    x, y = np.asarray(x, float), np.asarray(y, float)
-    if len(x) < 3:
-        return float("nan")
-
-    def ranks(v):
-        order = np.argsort(v, kind="mergesort")
-        r = np.empty(len(v))
-        r[order] = np.arange(1, len(v) + 1)
-        for value in np.unique(v):
-            tied = v == value
-            r[tied] = r[tied].mean()
-        return r
-
-    rx, ry = ranks(x), ranks(y)
-    rx, ry = rx - rx.mean(), ry - ry.mean()
-    return float((rx * ry).sum() / np.sqrt((rx * rx).sum() * (ry * ry).sum()))
 
 
 def leaves_out(r):
