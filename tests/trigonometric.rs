@@ -10,10 +10,10 @@ mod common;
 
 use common::*;
 use modal_mass_spring::fmi::variables::vr;
-use modal_mass_spring::physics::engine::{Engine, Stepper};
+use modal_mass_spring::physics::engine::{Engine, Probe, Stepper};
 use modal_mass_spring::physics::error::StepFailure;
 use modal_mass_spring::physics::integrator::{Propagator, Trigonometric};
-use modal_mass_spring::physics::space::{Diagonal, Space};
+use modal_mass_spring::physics::space::{Diagonal, Layout, Readout, Space};
 use modal_mass_spring::physics::*;
 use modal_mass_spring::scenes;
 
@@ -169,14 +169,9 @@ impl Space for Linear {
     fn scene(&self) -> &Scene {
         &self.scene
     }
-    fn coordinates(&self) -> usize {
-        self.lambda.len()
-    }
-    fn kept_modes(&self) -> Option<usize> {
-        Some(self.lambda.len())
-    }
-    fn frequencies(&self) -> &[f64] {
-        &self.frequencies
+    fn layout(&self) -> Layout<'_> {
+        let n = self.lambda.len();
+        Layout { scene: &self.scene, coordinates: n, kept_modes: Some(n), springs: 0, frequencies: &self.frequencies, newton_scale: 1.0 }
     }
     fn work(&self) -> LinearWork {
         LinearWork { damping: vec![0.0; self.lambda.len()], load: vec![0.0; self.lambda.len()] }
@@ -188,11 +183,6 @@ impl Space for Linear {
         for i in 0..self.lambda.len() {
             w.damping[i] = loads.damping_alpha + loads.damping_beta * self.lambda[i];
             w.load[i] = loads.mode_weights[i] * self.load[i];
-        }
-    }
-    fn spring_force(&self, y: &[f64], _w: &mut LinearWork, out: &mut [f64]) {
-        for i in 0..y.len() {
-            out[i] = -self.lambda[i] * y[i];
         }
     }
     fn force(&self, _loads: &Loads, y: &[f64], w: &mut LinearWork, h: &mut [f64]) {
@@ -217,14 +207,20 @@ impl Space for Linear {
     fn solve(&self, _w: &mut LinearWork, _rhs: &mut [f64]) {
         unreachable!("the trigonometric scheme only")
     }
-    fn newton_scale(&self) -> f64 {
-        1.0
-    }
     fn omega_sq_bound(&self, _loads: &Loads) -> f64 {
         self.lambda.iter().fold(0.0, |m, &l| m.max(l))
     }
     fn diagonal<'a>(&'a self, w: &'a LinearWork) -> Option<Diagonal<'a>> {
         Some(Diagonal { stiffness: &self.lambda, damping: &w.damping, load: &w.load })
+    }
+    fn add_translation_rate(&self, _loads: &Loads, _c: &[f64; 3], _v: &mut [f64]) {}
+}
+
+impl Readout for Linear {
+    fn spring_force(&self, y: &[f64], _w: &mut LinearWork, out: &mut [f64]) {
+        for i in 0..y.len() {
+            out[i] = -self.lambda[i] * y[i];
+        }
     }
     fn positions<'w>(&self, _y: &[f64], _w: &'w mut LinearWork) -> &'w [f64] {
         &[]
@@ -241,7 +237,6 @@ impl Space for Linear {
     fn kinetic_energy(&self, v: &[f64]) -> f64 {
         0.5 * v.iter().map(|v| v * v).sum::<f64>()
     }
-    fn add_translation_rate(&self, _loads: &Loads, _c: &[f64; 3], _v: &mut [f64]) {}
     fn momentum(&self, _v: &[f64]) -> [f64; 3] {
         [0.0; 3]
     }
@@ -253,7 +248,6 @@ impl Space for Linear {
         0.0
     }
 }
-
 /// Stiffnesses of the linear space: a free coordinate, slow, middle and
 /// fast ones (omega = 0, 2, 10, 50, 100 rad/s).
 const LAMBDA: [f64; 5] = [0.0, 4.0, 100.0, 2500.0, 1e4];

@@ -17,6 +17,7 @@ use super::scene::Scene;
 use super::settings::{ForceEvaluation, Integrator, Reduction, Settings};
 use super::space::{Cubature, Exact, Full, Layout, Modal, Readout};
 use super::state::{Loads, State};
+use super::training;
 
 /// The registry: builds the space `settings.reduction` names on `scene`
 /// (with the force model `settings.force_evaluation` names in the modal
@@ -28,7 +29,18 @@ pub(crate) fn build(scene: Scene, settings: &Settings, loads: &Loads, prebuilt: 
     match settings.reduction {
         Reduction::Modal => match settings.force_evaluation {
             ForceEvaluation::Exact => bind(Modal::<Exact>::new(scene, loads, settings, prebuilt)?, settings.integrator),
-            ForceEvaluation::Cubature => bind(Modal::<Cubature>::new(scene, loads, settings, prebuilt)?, settings.integrator),
+            ForceEvaluation::Cubature => {
+                // The spring set is trained on the exact reduced model unless it is stored.
+                let trained;
+                let prebuilt = match prebuilt {
+                    Some(data) if data.cubature.is_some() => Some(data),
+                    _ => {
+                        trained = training::train(scene.clone(), loads, settings, prebuilt)?;
+                        Some(&trained)
+                    }
+                };
+                bind(Modal::<Cubature>::new(scene, loads, settings, prebuilt)?, settings.integrator)
+            }
         },
         Reduction::Full => bind(Full::new(scene, loads, settings)?, settings.integrator),
     }

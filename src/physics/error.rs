@@ -205,7 +205,11 @@ pub enum PhysicsError {
     TooManyInternalSteps { h: f64, steps: f64, dt: f64, limit: usize },
     /// A communication step failed; the state is that of its start.
     #[error("step from t = {time} s failed: {cause}")]
-    StepFailed { time: f64, #[source] cause: StepFailure },
+    StepFailed {
+        time: f64,
+        #[source]
+        cause: StepFailure,
+    },
     /// The cubature set could not be grown to the tolerance within its
     /// size limit, or no spring left improves the fit.
     #[error("the cubature reached a relative force error of {reached:.3e} with {springs} springs, its limit (at most 1000 and half the springs), or the fit stopped improving, short of half the tolerance {tolerance:e} (the training's margin); that tolerance needs exact forces")]

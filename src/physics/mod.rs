@@ -13,6 +13,7 @@
 //! - [`engine`]: a space and a scheme bound together;
 //! - [`state`]: [`State`] and [`Loads`], what changes while running;
 //! - [`simulator`]: set-up, sub-stepping, divergence checks, outputs;
+//! - [`training`]: the cubature's training, a set-up stage that runs the exact reduced model;
 //! - [`bake`]: the costly products of a modal set-up as data, to store and reuse;
 //! - [`error`]: typed errors that name the quantity and the limit.
 //!
@@ -33,6 +34,7 @@ pub mod settings;
 pub mod simulator;
 pub mod space;
 pub mod state;
+pub mod training;
 
 pub use bake::{SetupData, SpringSet};
 pub use error::{PhysicsError, Quantity, StepFailure};

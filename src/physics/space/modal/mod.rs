@@ -24,7 +24,7 @@ mod cubature;
 mod exact;
 mod reduced;
 
-pub use cubature::Cubature;
+pub use cubature::{Candidate, Cubature};
 pub use exact::Exact;
 pub use reduced::{taut_reduced_bound, ForceSetup, Modes, ReducedForce};
 
@@ -124,6 +124,11 @@ impl<F: ReducedForce> Modal<F> {
     /// The kept modes.
     pub fn basis(&self) -> &ModalBasis {
         &self.modes.basis
+    }
+
+    /// The kept modes in both layouts, and the point they are measured from.
+    pub fn modes(&self) -> &Modes {
+        &self.modes
     }
 }
 

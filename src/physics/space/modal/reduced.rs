@@ -78,7 +78,7 @@ pub struct Modes {
 }
 
 impl Modes {
-    pub(crate) fn new(basis: ModalBasis, point: Vec<f64>, at_rest: bool) -> Self {
+    pub fn new(basis: ModalBasis, point: Vec<f64>, at_rest: bool) -> Self {
         let (n, r) = (basis.n, basis.r);
         let cols = (0..r).flat_map(|j| (0..n).map(move |k| (k, j))).map(|(k, j)| basis.phi[k * r + j]).collect();
         Modes { basis, cols, point, at_rest }
