@@ -16,7 +16,7 @@ use std::process::Command;
 use std::time::Instant;
 
 use crate::setup::{cargo, target_dir};
-use crate::{fmu, fmusim, fuzz, setup, valgrind};
+use crate::{cli, fmu, fmusim, fuzz, setup, valgrind};
 
 /// Packages and features of every cargo build of the test stage: the same
 /// for the tests, the quick study and the valgrind example, so each builds
@@ -46,7 +46,18 @@ fn step(title: &str) {
     eprintln!("\n==> {title}");
 }
 
+const RUN_USAGE: &str = "\
+usage: cargo xtask run [--] [MAIN JOB ARGS...]
+
+Installs what it needs, builds target/fmu/ModalMassSpring.fmu and runs
+python/main_job.py on it with every argument (`cargo xtask run -- --help`
+shows them all), e.g. --stop-time S, --out PNG.";
+
 pub fn run(args: &[String]) -> Result<(), String> {
+    let Some(args) = cli::options(cli::pass_through(args), RUN_USAGE)? else {
+        setup::python_help("python/main_job.py");
+        return Ok(());
+    };
     let root = setup::root();
     step("setup: what building and running need");
     setup::install(setup::Purpose::Run)?;
@@ -58,7 +69,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
         .current_dir(&root)
         .arg("python/main_job.py")
         .arg(&fmu)
-        .args(args)
+        .args(&args)
         .status()
         .map_err(|e| format!("cannot run the venv's python: {e}"))?;
     if !status.success() {
