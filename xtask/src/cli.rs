@@ -43,7 +43,7 @@ pub fn rest(p: &mut lexopt::Parser) -> Result<Vec<String>, Error> {
     if raw.peek().is_some_and(|a| a == "--") {
         raw.next();
     }
-    raw.map(|a: OsString| a.into_string().map_err(|a| Error::NonUnicodeValue(a))).collect()
+    raw.map(|a: OsString| a.into_string().map_err(Error::NonUnicodeValue)).collect()
 }
 
 /// Arguments handed on whole to another program (`run`, `sweep`): `None`
