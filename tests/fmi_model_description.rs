@@ -5,6 +5,9 @@
 
 #[path = "../modelDescription/generate.rs"]
 mod generate;
+// Spec::model_description_xml, written with fmi-schema.
+#[path = "../modelDescription/generate/xml.rs"]
+mod model_description_xml;
 
 use std::collections::BTreeMap;
 

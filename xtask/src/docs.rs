@@ -2,11 +2,14 @@
 //! enumerations and the canonical scenes from modelDescription/variables.toml,
 //! between the markers `tests/fmi_model_description.rs` checks.
 
+use crate::cli;
 use crate::generate::{self, README_BEGIN, README_END};
 
+const USAGE: &str = "usage: cargo xtask docs (no options)";
+
 pub fn main(args: &[String]) -> Result<(), String> {
-    if !args.is_empty() {
-        return Err("usage: cargo xtask docs".into());
+    if cli::options(cli::no_arguments(args), USAGE)?.is_none() {
+        return Ok(());
     }
     let root = crate::setup::root();
     let spec = generate::load(&root.join("modelDescription/variables.toml"))?;

@@ -8,6 +8,7 @@
 //! values (basis, equilibrium, cubature set), computed once here by the
 //! `bake` example so that instantiation skips it while the parameters match.
 
+use crate::cli::{self, Long, ValueExt};
 use crate::generate;
 
 use std::collections::BTreeMap;
@@ -28,24 +29,33 @@ struct Options {
     out: Option<PathBuf>,
 }
 
-fn parse(args: &[String]) -> Result<Options, String> {
+const USAGE: &str = "\
+usage: cargo xtask fmu [--scene NAME] [--nx N] [--ny N] [--modes R] [--bake] [--out PATH]
+
+  --scene NAME  start values of a canonical scene (modelDescription/variables.toml)
+  --nx N        nodes per row (the load column follows the middle of the row)
+  --ny N        rows of nodes
+  --modes R     modes kept (nModes)
+  --bake        also resources/setup.bin: the modal set-up of these start values
+  --out PATH    where the FMU goes (default target/fmu/NAME.fmu, NAME the scene or
+                ModalMassSpring, with -nxN, -nyN, -modesR appended when given)";
+
+fn parse(args: &[String]) -> Result<Option<Options>, cli::Error> {
     let mut o = Options { scene: None, nx: None, ny: None, modes: None, bake: false, out: None };
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        let mut value = || it.next().cloned().ok_or(format!("{a} needs a value"));
-        let number = |v: String| v.parse::<u64>().map_err(|_| format!("{a}: not a non-negative integer: {v}"));
-        match a.as_str() {
-            "--scene" => o.scene = Some(value()?),
-            "--nx" => o.nx = Some(number(value()?)?),
-            "--ny" => o.ny = Some(number(value()?)?),
-            "--modes" => o.modes = Some(number(value()?)?),
-            "--out" => o.out = Some(PathBuf::from(value()?)),
-            "--bake" => o.bake = true,
-            "-h" | "--help" => return Err("usage: cargo xtask fmu [--scene NAME] [--nx N] [--ny N] [--modes R] [--bake] [--out PATH]".into()),
-            other => return Err(format!("unknown option {other}")),
+    let mut p = cli::parser(args);
+    while let Some(arg) = p.next()? {
+        match arg {
+            Long("scene") => o.scene = Some(p.value()?.string()?),
+            Long("nx") => o.nx = Some(p.value()?.parse()?),
+            Long("ny") => o.ny = Some(p.value()?.parse()?),
+            Long("modes") => o.modes = Some(p.value()?.parse()?),
+            Long("out") => o.out = Some(PathBuf::from(p.value()?)),
+            Long("bake") => o.bake = true,
+            arg if cli::is_help(&arg) => return Ok(None),
+            arg => return Err(arg.unexpected()),
         }
     }
-    Ok(o)
+    Ok(Some(o))
 }
 
 /// Builds the FMU's shared library (release, the product's features only)
@@ -64,7 +74,7 @@ pub fn build_library(root: &Path) -> Result<PathBuf, String> {
 }
 
 pub fn main(args: &[String]) -> Result<(), String> {
-    let o = parse(args)?;
+    let Some(o) = cli::options(parse(args), USAGE)? else { return Ok(()) };
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf();
     let spec = generate::load(&root.join("modelDescription/variables.toml"))?;
 

@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::SystemTime;
 
+use crate::cli::{self, Long};
 use crate::setup::target_dir;
 
 /// The vendored source tree, relative to the repository root.
@@ -37,14 +38,29 @@ pub fn binary(root: &Path) -> PathBuf {
 }
 
 pub fn main(args: &[String]) -> Result<(), String> {
-    let force = match args {
-        [] => false,
-        [f] if f == "--force" => true,
-        _ => return Err("usage: cargo xtask fmusim [--force]".into()),
-    };
+    let Some(force) = cli::options(parse(args), USAGE)? else { return Ok(()) };
     let path = build(&crate::setup::root(), force)?;
     println!("{}", path.display());
     Ok(())
+}
+
+const USAGE: &str = "\
+usage: cargo xtask fmusim [--force]
+
+  --force  build again even if the binary is newer than its sources";
+
+/// Whether to force the build.
+fn parse(args: &[String]) -> Result<Option<bool>, cli::Error> {
+    let mut force = false;
+    let mut p = cli::parser(args);
+    while let Some(arg) = p.next()? {
+        match arg {
+            Long("force") => force = true,
+            arg if cli::is_help(&arg) => return Ok(None),
+            arg => return Err(arg.unexpected()),
+        }
+    }
+    Ok(Some(force))
 }
 
 /// The C files to compile, relative to the source tree, sorted.

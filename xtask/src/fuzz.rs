@@ -19,6 +19,7 @@ use std::path::PathBuf;
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
+use crate::cli::{self, Long, Value, ValueExt};
 use crate::setup;
 use crate::setup::{cargo, target_dir};
 
@@ -31,24 +32,44 @@ pub struct Report {
     pub seconds: f64,
 }
 
-pub fn main(args: &[String]) -> Result<(), String> {
-    let mut seconds = DEFAULT_SECONDS;
-    let mut linked = false;
-    let mut targets: Vec<String> = Vec::new();
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        match a.as_str() {
-            "--seconds" => {
-                let v = it.next().ok_or("--seconds needs a value")?;
-                seconds = v.parse().map_err(|_| format!("--seconds: not a number: {v}"))?;
+const USAGE: &str = "\
+usage: cargo xtask fuzz [--seconds N] [--linked] [TARGET...]
+
+  --seconds N  fuzzing time per target (default 30)
+  --linked     build the FMU crate into the targets, coverage-instrumented,
+               without a sanitizer (minutes to build, deeper runs)
+  TARGET       deserialize, call_sequence (default: every target)";
+
+struct Options {
+    seconds: u64,
+    linked: bool,
+    targets: Vec<String>,
+}
+
+fn parse(args: &[String]) -> Result<Option<Options>, cli::Error> {
+    let mut o = Options { seconds: DEFAULT_SECONDS, linked: false, targets: Vec::new() };
+    let mut p = cli::parser(args);
+    while let Some(arg) = p.next()? {
+        match arg {
+            Long("seconds") => o.seconds = p.value()?.parse()?,
+            Long("linked") => o.linked = true,
+            Value(t) => {
+                let t = t.string()?;
+                if !TARGETS.contains(&t.as_str()) {
+                    return Err(format!("unknown target {t} (targets: {})", TARGETS.join(", ")).into());
+                }
+                o.targets.push(t);
             }
-            "--linked" => linked = true,
-            "-h" | "--help" => return Err("usage: cargo xtask fuzz [--seconds N] [--linked] [TARGET...]".into()),
-            t if TARGETS.contains(&t) => targets.push(t.to_string()),
-            other => return Err(format!("unknown option or target {other} (targets: {})", TARGETS.join(", "))),
+            arg if cli::is_help(&arg) => return Ok(None),
+            arg => return Err(arg.unexpected()),
         }
     }
-    let reports = run(&targets, seconds, linked)?;
+    Ok(Some(o))
+}
+
+pub fn main(args: &[String]) -> Result<(), String> {
+    let Some(o) = cli::options(parse(args), USAGE)? else { return Ok(()) };
+    let reports = run(&o.targets, o.seconds, o.linked)?;
     for r in &reports {
         println!("fuzz {}: {} executions in {:.0} s, no crash", r.target, r.runs, r.seconds);
     }

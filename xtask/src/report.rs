@@ -6,24 +6,44 @@
 
 use std::process::Command;
 
-pub fn main(args: &[String]) -> Result<(), String> {
-    let quick = args.iter().any(|a| a == "--quick");
-    let out = args.iter().position(|a| a == "--out").and_then(|i| args.get(i + 1)).cloned().unwrap_or_else(|| "report".into());
-    // What the study itself takes besides --quick and --out.
-    let mut study_args = Vec::new();
-    let mut i = 0;
-    while i < args.len() {
-        match args[i].as_str() {
-            "--log" | "--variants-only" => study_args.push(args[i].clone()),
-            "--scene" => {
-                study_args.extend(args.get(i..i + 2).ok_or("--scene takes a scene name")?.iter().cloned());
-                i += 1;
-            }
-            _ => {}
+use crate::cli::{self, Long, ValueExt};
+
+const USAGE: &str = "\
+usage: cargo xtask report [--quick] [--out DIR] [--log] [--scene NAME]... [--variants-only]
+
+  --quick          the small study (CI)
+  --out DIR        where the CSV and the plots go (default report)
+  --log            print every run as it ends
+  --scene NAME     only this scene (repeatable): a partial report
+  --variants-only  only the variants of the study: a partial report";
+
+struct Options {
+    quick: bool,
+    out: String,
+    /// What the study itself takes besides --quick and --out.
+    study_args: Vec<String>,
+}
+
+fn parse(args: &[String]) -> Result<Option<Options>, cli::Error> {
+    let mut o = Options { quick: false, out: "report".into(), study_args: Vec::new() };
+    let mut p = cli::parser(args);
+    while let Some(arg) = p.next()? {
+        match arg {
+            Long("quick") => o.quick = true,
+            Long("out") => o.out = p.value()?.string()?,
+            Long("log") => o.study_args.push("--log".into()),
+            Long("variants-only") => o.study_args.push("--variants-only".into()),
+            Long("scene") => o.study_args.extend(["--scene".into(), p.value()?.string()?]),
+            arg if cli::is_help(&arg) => return Ok(None),
+            arg => return Err(arg.unexpected()),
         }
-        i += 1;
     }
-    run_with(quick, &out, &[], &study_args)
+    Ok(Some(o))
+}
+
+pub fn main(args: &[String]) -> Result<(), String> {
+    let Some(o) = cli::options(parse(args), USAGE)? else { return Ok(()) };
+    run_with(o.quick, &o.out, &[], &o.study_args)
 }
 
 /// The study with `cargo_args` added to its `cargo run` (`cargo xtask test`

@@ -3,18 +3,21 @@
 //! - `run [--out PNG] [--stop-time S]`: setup, build `target/fmu/ModalMassSpring.fmu`,
 //!   then the main job `python/main_job.py` (fmpy simulates the default scene,
 //!   prints a summary and writes `out/default_scene.png`).
-//! - `test [PYTEST ARGS...]`: setup, build the default FMU and one scene-baked FMU
-//!   per canonical scene into `target/fmu/`, run `cargo test --release --workspace`
-//!   (with the XSD validation of the model description and the soak run of a
-//!   million steps), each fuzz target for FUZZ_SECONDS, the quick study,
-//!   the reference importer fmusim (`target/tools/fmusim`), pytest on
+//! - `test [--only STAGE[,STAGE...]] [PYTEST ARGS...]`: setup, build the
+//!   default FMU and one scene-baked FMU per canonical scene into
+//!   `target/fmu/`, `cargo fmt --check`, each fuzz target for FUZZ_SECONDS,
+//!   `cargo test --release --workspace` (with the XSD validation of the model
+//!   description and the soak run of a million steps), the quick study, the
+//!   reference importer fmusim (`target/tools/fmusim`), pytest on
 //!   `tests/python` with the venv's Python and the valgrind leak check.
-//!   Every stage always runs; the task fails if any fails.
+//!   Every stage runs (CI); the task fails if any fails. `--only` runs the
+//!   stages named, for a quick loop, and what pytest needs of the others.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
+use crate::cli::{self, Long, ValueExt};
 use crate::setup::{cargo, target_dir};
 use crate::{fmu, fmusim, fuzz, setup, valgrind};
 
@@ -46,7 +49,18 @@ fn step(title: &str) {
     eprintln!("\n==> {title}");
 }
 
+const RUN_USAGE: &str = "\
+usage: cargo xtask run [--] [MAIN JOB ARGS...]
+
+Installs what it needs, builds target/fmu/ModalMassSpring.fmu and runs
+python/main_job.py on it with every argument (`cargo xtask run -- --help`
+shows them all), e.g. --stop-time S, --out PNG.";
+
 pub fn run(args: &[String]) -> Result<(), String> {
+    let Some(args) = cli::options(cli::pass_through(args), RUN_USAGE)? else {
+        setup::python_help("python/main_job.py");
+        return Ok(());
+    };
     let root = setup::root();
     step("setup: what building and running need");
     setup::install(setup::Purpose::Run)?;
@@ -58,7 +72,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
         .current_dir(&root)
         .arg("python/main_job.py")
         .arg(&fmu)
-        .args(args)
+        .args(&args)
         .status()
         .map_err(|e| format!("cannot run the venv's python: {e}"))?;
     if !status.success() {
@@ -102,123 +116,241 @@ fn prepare_xsd(root: &Path, test_args: &[&str]) -> Result<(), String> {
     }
 }
 
+const TEST_USAGE: &str = "\
+usage: cargo xtask test [--only STAGE[,STAGE...]] [--] [PYTEST ARGS...]
+
+Every stage, in this order (CI runs them all):
+  setup     cargo xtask setup (what the tests need)
+  fmu       the default FMU and one FMU per canonical scene, into target/fmu/
+  fmt       cargo fmt --check
+  fuzz      each fuzz target for 30 s
+  rust      cargo test --release --workspace --features xsd
+  report    cargo xtask report --quick, into target/report-quick/
+  fmusim    the reference importer, into target/tools/fmusim
+  python    pytest tests/python (with PYTEST ARGS)
+  valgrind  cargo xtask valgrind
+
+  --only STAGE,...  run only these stages; python also builds the FMUs and
+                    fmusim when out of date and the quick report when missing.
+                    Without setup, run `cargo xtask setup` once beforehand.
+Arguments after the options (or after --) go to pytest.";
+
+/// The stages of `cargo xtask test`, in the order they run.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Stage {
+    Setup,
+    Fmu,
+    Fmt,
+    Fuzz,
+    Rust,
+    Report,
+    Fmusim,
+    Python,
+    Valgrind,
+}
+
+const STAGES: [(&str, Stage); 9] = [
+    ("setup", Stage::Setup),
+    ("fmu", Stage::Fmu),
+    ("fmt", Stage::Fmt),
+    ("fuzz", Stage::Fuzz),
+    ("rust", Stage::Rust),
+    ("report", Stage::Report),
+    ("fmusim", Stage::Fmusim),
+    ("python", Stage::Python),
+    ("valgrind", Stage::Valgrind),
+];
+
+impl Stage {
+    fn name(self) -> &'static str {
+        STAGES.iter().find(|(_, s)| *s == self).map_or("?", |(n, _)| n)
+    }
+}
+
+struct TestOptions {
+    /// The stages `--only` names; `None`: every stage.
+    only: Option<Vec<Stage>>,
+    pytest: Vec<String>,
+}
+
+/// `--only` (and `-h`) first; the first other argument starts pytest's.
+fn parse_test(args: &[String]) -> Result<Option<TestOptions>, cli::Error> {
+    let mut only: Option<Vec<Stage>> = None;
+    let mut p = cli::parser(args);
+    while cli::peek(&mut p).is_some_and(|a| ["-h", "--help", "--only"].contains(&a.as_str()) || a.starts_with("--only=")) {
+        match p.next()? {
+            Some(Long("only")) => {
+                let list = p.value()?.string()?;
+                for name in list.split(',').map(str::trim) {
+                    let stage = STAGES.iter().find(|(n, _)| *n == name).map(|(_, s)| *s);
+                    let known: Vec<&str> = STAGES.iter().map(|(n, _)| *n).collect();
+                    let stage = stage.ok_or(format!("--only: unknown stage {name:?} (stages: {})", known.join(", ")))?;
+                    only.get_or_insert_with(Vec::new).push(stage);
+                }
+            }
+            _ => return Ok(None),
+        }
+    }
+    Ok(Some(TestOptions { only, pytest: cli::rest(&mut p)? }))
+}
+
 pub fn test(args: &[String]) -> Result<(), String> {
+    let Some(o) = cli::options(parse_test(args), TEST_USAGE)? else { return Ok(()) };
+    let selected = |stage: Stage| o.only.as_ref().is_none_or(|only| only.contains(&stage));
+    let partial = o.only.is_some();
     let root = setup::root();
+    let report_dir = target_dir(&root).join("report-quick");
+    // What pytest needs of the other stages, when `--only` leaves them out:
+    // fresh FMUs, an up-to-date fmusim (both cheap when nothing changed) and
+    // the quick report (only when it is missing: it takes minutes).
+    let python = selected(Stage::Python);
+    let needed = |stage: Stage| {
+        let for_python = python
+            && match stage {
+                Stage::Fmu | Stage::Fmusim => true,
+                Stage::Report => !report_dir.join("error_vs_runtime.csv").exists(),
+                _ => false,
+            };
+        if !selected(stage) && for_python {
+            eprintln!("\nxtask test: running {} as well, which python needs", stage.name());
+        }
+        selected(stage) || for_python
+    };
     let mut times: Vec<(&str, f64)> = Vec::new();
     let mut clock = Instant::now();
     let mut lap = |name: &'static str, times: &mut Vec<(&str, f64)>| {
         times.push((name, clock.elapsed().as_secs_f64()));
         clock = Instant::now();
     };
-    step("setup");
-    setup::install(setup::Purpose::Test)?;
-    lap("setup", &mut times);
-
-    step("cargo xtask fmu (default and every canonical scene)");
-    fmu::main(&[])?;
-    for scene in scene_names(&root)? {
-        fmu::main(&["--scene".to_string(), scene])?;
+    if selected(Stage::Setup) {
+        step("setup");
+        setup::install(setup::Purpose::Test)?;
+        lap("setup", &mut times);
     }
-    lap("FMUs", &mut times);
+
+    if needed(Stage::Fmu) {
+        step("cargo xtask fmu (default and every canonical scene)");
+        fmu::main(&[])?;
+        for scene in scene_names(&root)? {
+            fmu::main(&["--scene".to_string(), scene])?;
+        }
+        lap("FMUs", &mut times);
+    }
 
     let mut failures = Vec::new();
 
-    step("cargo fmt --check (rustfmt.toml)");
-    let rustfmt = Command::new(cargo()).args(["fmt", "--version"]).output().is_ok_and(|o| o.status.success());
-    if rustfmt {
-        for dir in [root.clone(), root.join("fuzz")] {
-            let status =
-                Command::new(cargo()).current_dir(&dir).args(["fmt", "--all", "--check"]).status().map_err(|e| format!("cannot run cargo fmt: {e}"))?;
-            if !status.success() {
-                failures.push(format!("formatting differs from rustfmt in {} (run `cargo fmt --all` there)", dir.display()));
+    if selected(Stage::Fmt) {
+        step("cargo fmt --check (rustfmt.toml)");
+        let rustfmt = Command::new(cargo()).args(["fmt", "--version"]).output().is_ok_and(|o| o.status.success());
+        if rustfmt {
+            for dir in [root.clone(), root.join("fuzz")] {
+                let status =
+                    Command::new(cargo()).current_dir(&dir).args(["fmt", "--all", "--check"]).status().map_err(|e| format!("cannot run cargo fmt: {e}"))?;
+                if !status.success() {
+                    failures.push(format!("formatting differs from rustfmt in {} (run `cargo fmt --all` there)", dir.display()));
+                }
             }
+        } else {
+            eprintln!("rustfmt is not installed: formatting not checked");
         }
-    } else {
-        eprintln!("rustfmt is not installed: formatting not checked");
+        lap("fmt", &mut times);
     }
 
     // Right after the FMU build: the fuzz targets load its library as it is
     // (the test build below compiles the crate with other features).
-    step(&format!("fuzzing: cargo xtask fuzz --seconds {FUZZ_SECONDS}"));
-    let targets: Vec<String> = Vec::new();
-    match fuzz::run(&targets, FUZZ_SECONDS, false) {
-        Ok(reports) => {
-            for r in reports {
-                eprintln!("fuzz {}: {} executions in {:.0} s, no crash", r.target, r.runs, r.seconds);
+    if selected(Stage::Fuzz) {
+        step(&format!("fuzzing: cargo xtask fuzz --seconds {FUZZ_SECONDS}"));
+        let targets: Vec<String> = Vec::new();
+        match fuzz::run(&targets, FUZZ_SECONDS, false) {
+            Ok(reports) => {
+                for r in reports {
+                    eprintln!("fuzz {}: {} executions in {:.0} s, no crash", r.target, r.runs, r.seconds);
+                }
             }
+            Err(e) => failures.push(e),
         }
-        Err(e) => failures.push(e),
+        lap("fuzz", &mut times);
     }
-    lap("fuzz", &mut times);
 
-    step("cargo test --release --workspace --features xsd");
-    // Release profile: the FMUs above already built every dependency in it,
-    // so the tests compile only themselves (the dev profile would build faer
-    // a second time, most of CI's time).
-    let test_args = ["test", "--release", TEST_CARGO_ARGS[0], TEST_CARGO_ARGS[1], TEST_CARGO_ARGS[2]];
-    prepare_xsd(&root, &test_args)?;
-    let status = Command::new(cargo()).current_dir(&root).args(test_args).status().map_err(|e| format!("cannot run cargo: {e}"))?;
-    if !status.success() {
-        failures.push(format!("cargo test ({status})"));
+    if selected(Stage::Rust) {
+        step("cargo test --release --workspace --features xsd");
+        // Release profile: the FMUs above already built every dependency in it,
+        // so the tests compile only themselves (the dev profile would build faer
+        // a second time, most of CI's time).
+        let test_args = ["test", "--release", TEST_CARGO_ARGS[0], TEST_CARGO_ARGS[1], TEST_CARGO_ARGS[2]];
+        prepare_xsd(&root, &test_args)?;
+        let status = Command::new(cargo()).current_dir(&root).args(test_args).status().map_err(|e| format!("cannot run cargo: {e}"))?;
+        if !status.success() {
+            failures.push(format!("cargo test ({status})"));
+        }
+        lap("cargo test", &mut times);
     }
-    lap("cargo test", &mut times);
 
-    step("cargo xtask report --quick");
-    let report_dir = target_dir(&root).join("report-quick");
-    if let Err(e) = crate::report::run(true, &report_dir.display().to_string(), &TEST_CARGO_ARGS) {
-        failures.push(format!("report --quick: {e}"));
+    if needed(Stage::Report) {
+        step("cargo xtask report --quick");
+        if let Err(e) = crate::report::run(true, &report_dir.display().to_string(), &TEST_CARGO_ARGS) {
+            failures.push(format!("report --quick: {e}"));
+        }
+        lap("report --quick", &mut times);
     }
-    lap("report --quick", &mut times);
 
     // tests/python/test_fmusim.py runs the FMU in the reference importer;
     // on CI a missing binary fails those tests.
-    step("cargo xtask fmusim");
-    let fmusim = match fmusim::build(&root, false) {
-        Ok(path) => Some(path),
-        Err(e) => {
-            failures.push(format!("fmusim: {e}"));
-            None
+    let mut fmusim = None;
+    if needed(Stage::Fmusim) {
+        step("cargo xtask fmusim");
+        match fmusim::build(&root, false) {
+            Ok(path) => fmusim = Some(path),
+            Err(e) => failures.push(format!("fmusim: {e}")),
         }
-    };
-    lap("fmusim", &mut times);
+        lap("fmusim", &mut times);
+    }
 
-    step("pytest tests/python");
-    let mut pytest = Command::new(setup::python());
-    if let Some(path) = &fmusim {
-        pytest.env("MMS_FMUSIM", path);
+    if python {
+        step("pytest tests/python");
+        let mut pytest = Command::new(setup::python());
+        if let Some(path) = &fmusim {
+            pytest.env("MMS_FMUSIM", path);
+        }
+        let status = pytest
+            .current_dir(&root)
+            .env("MMS_FMU_DIR", fmu_dir(&root))
+            .env("MMS_REPORT_DIR", &report_dir)
+            .args(["-m", "pytest", "tests/python", "-ra", "-p", "no:cacheprovider"])
+            .args(&o.pytest)
+            .status()
+            .map_err(|e| format!("cannot run the venv's python (`cargo xtask setup` makes it): {e}"))?;
+        // pytest: 0 all passed, 1 some failed, 2 interrupted, 3 internal error,
+        // 4 usage error, 5 no test collected (a failure here: the suite must run).
+        match status.code() {
+            Some(0) => {}
+            Some(1) => failures.push("pytest: some tests failed".into()),
+            Some(5) => failures.push("pytest collected no test".into()),
+            Some(c) => failures.push(format!("pytest did not complete (exit code {c})")),
+            None => failures.push(format!("pytest was killed ({status})")),
+        }
+        lap("pytest", &mut times);
     }
-    let status = pytest
-        .current_dir(&root)
-        .env("MMS_FMU_DIR", fmu_dir(&root))
-        .env("MMS_REPORT_DIR", &report_dir)
-        .args(["-m", "pytest", "tests/python", "-ra", "-p", "no:cacheprovider"])
-        .args(args)
-        .status()
-        .map_err(|e| format!("cannot run the venv's python: {e}"))?;
-    // pytest: 0 all passed, 1 some failed, 2 interrupted, 3 internal error,
-    // 4 usage error, 5 no test collected (a failure here: the suite must run).
-    match status.code() {
-        Some(0) => {}
-        Some(1) => failures.push("pytest: some tests failed".into()),
-        Some(5) => failures.push("pytest collected no test".into()),
-        Some(c) => failures.push(format!("pytest did not complete (exit code {c})")),
-        None => failures.push(format!("pytest was killed ({status})")),
-    }
-    lap("pytest", &mut times);
 
-    step("valgrind: cargo xtask valgrind");
-    if let Err(e) = valgrind::run(valgrind::DEFAULT_CYCLES, &TEST_CARGO_ARGS) {
-        failures.push(e);
+    if selected(Stage::Valgrind) {
+        step("valgrind: cargo xtask valgrind");
+        if let Err(e) = valgrind::run(valgrind::DEFAULT_CYCLES, &TEST_CARGO_ARGS) {
+            failures.push(e);
+        }
+        lap("valgrind", &mut times);
     }
-    lap("valgrind", &mut times);
 
     let summary: Vec<String> = times.iter().map(|(n, t)| format!("{n} {t:.0} s")).collect();
     eprintln!("\ntimes: {}", summary.join(", "));
 
-    if failures.is_empty() {
-        eprintln!("\nall tests passed (cargo test, pytest with fmpy and fmusim, valgrind, fuzzing)");
+    if !failures.is_empty() {
+        Err(format!("failed: {}", failures.join("; ")))
+    } else if partial {
+        let names: Vec<&str> = STAGES.iter().filter(|(_, s)| selected(*s)).map(|(_, s)| s.name()).collect();
+        eprintln!("\npassed: {} (--only)", names.join(", "));
         Ok(())
     } else {
-        Err(format!("failed: {}", failures.join("; ")))
+        eprintln!("\nall tests passed (cargo test, pytest with fmpy and fmusim, valgrind, fuzzing)");
+        Ok(())
     }
 }

@@ -17,6 +17,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
+use crate::cli::{self, Long, ValueExt};
+
 /// What the installation is for; each purpose needs what the ones before it need.
 #[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Purpose {
@@ -79,15 +81,45 @@ pub fn python() -> PathBuf {
     root().join(".venv/bin/python")
 }
 
+/// Prints the `--help` of a script of the project's Python, if the venv
+/// can run it (the options of the tasks that hand their arguments on).
+pub fn python_help(script: &str) {
+    let out = Command::new(python()).current_dir(root()).args([script, "--help"]).output();
+    if let Some(out) = out.ok().filter(|o| o.status.success()) {
+        println!("\n{script}:\n{}", String::from_utf8_lossy(&out.stdout));
+    }
+}
+
 pub fn main(args: &[String]) -> Result<(), String> {
-    let purpose = match args {
-        [] => Purpose::Test,
-        [f, p] if f == "--for" && p == "run" => Purpose::Run,
-        [f, p] if f == "--for" && p == "sweep" => Purpose::Sweep,
-        [f, p] if f == "--for" && p == "test" => Purpose::Test,
-        _ => return Err("usage: cargo xtask setup [--for run|sweep|test] (default: test, everything)".into()),
-    };
+    let Some(purpose) = cli::options(parse(args), USAGE)? else { return Ok(()) };
     install(purpose)
+}
+
+const USAGE: &str = "\
+usage: cargo xtask setup [--for run|sweep|test]
+
+  --for run    what building the FMU and the main job need
+  --for sweep  also parameter sweeps on Dask
+  --for test   also everything the tests need (the default)";
+
+fn parse(args: &[String]) -> Result<Option<Purpose>, cli::Error> {
+    let mut purpose = Purpose::Test;
+    let mut p = cli::parser(args);
+    while let Some(arg) = p.next()? {
+        match arg {
+            Long("for") => {
+                purpose = match p.value()?.string()?.as_str() {
+                    "run" => Purpose::Run,
+                    "sweep" => Purpose::Sweep,
+                    "test" => Purpose::Test,
+                    other => return Err(format!("--for {other}: one of run, sweep, test").into()),
+                }
+            }
+            arg if cli::is_help(&arg) => return Ok(None),
+            arg => return Err(arg.unexpected()),
+        }
+    }
+    Ok(Some(purpose))
 }
 
 /// Installs what `purpose` needs and is missing.

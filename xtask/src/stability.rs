@@ -4,9 +4,13 @@
 
 use std::process::Command;
 
+use crate::cli;
+
+const USAGE: &str = "usage: cargo xtask stability (no options)";
+
 pub fn main(args: &[String]) -> Result<(), String> {
-    if !args.is_empty() {
-        return Err("usage: cargo xtask stability".into());
+    if cli::options(cli::no_arguments(args), USAGE)?.is_none() {
+        return Ok(());
     }
     let status = Command::new(crate::setup::cargo())
         .current_dir(crate::setup::root())

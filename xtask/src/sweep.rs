@@ -6,13 +6,19 @@
 
 use std::process::Command;
 
-use crate::{fmu, setup};
+use crate::{cli, fmu, setup};
+
+const USAGE: &str = "\
+usage: cargo xtask sweep [--] [SWEEP ARGS...]
+
+Installs what the sweep needs, builds target/fmu/ModalMassSpring.fmu and
+passes every argument to python/sweep.py (`cargo xtask sweep -- --help`
+shows them all).";
 
 pub fn main(args: &[String]) -> Result<(), String> {
-    // `cargo xtask sweep -- ARGS` hands the `--` on.
-    let args = match args.split_first() {
-        Some((first, rest)) if first == "--" => rest,
-        _ => args,
+    let Some(args) = cli::options(cli::pass_through(args), USAGE)? else {
+        setup::python_help("python/sweep.py");
+        return Ok(());
     };
     let root = setup::root();
     setup::install(setup::Purpose::Sweep)?;
@@ -20,7 +26,7 @@ pub fn main(args: &[String]) -> Result<(), String> {
     let status = Command::new(setup::python())
         .current_dir(&root)
         .arg("python/sweep.py")
-        .args(args)
+        .args(&args)
         .status()
         .map_err(|e| format!("cannot run the venv's python: {e}"))?;
     if !status.success() {

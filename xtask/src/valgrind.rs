@@ -6,17 +6,32 @@
 
 use std::process::Command;
 
+use crate::cli::{self, Value, ValueExt};
 use crate::setup;
 
 pub const DEFAULT_CYCLES: &str = "12";
 
 pub fn main(args: &[String]) -> Result<(), String> {
-    let cycles = match args {
-        [] => DEFAULT_CYCLES.to_string(),
-        [n] if n.parse::<u32>().is_ok() => n.clone(),
-        _ => return Err("usage: cargo xtask valgrind [CYCLES]".into()),
-    };
+    let Some(cycles) = cli::options(parse(args), USAGE)? else { return Ok(()) };
     run(&cycles, &[])
+}
+
+const USAGE: &str = "\
+usage: cargo xtask valgrind [CYCLES]
+
+  CYCLES  instantiate/step/serialize/free cycles (default 12)";
+
+fn parse(args: &[String]) -> Result<Option<String>, cli::Error> {
+    let mut cycles = None;
+    let mut p = cli::parser(args);
+    while let Some(arg) = p.next()? {
+        match arg {
+            Value(n) if cycles.is_none() => cycles = Some(n.parse::<u32>()?.to_string()),
+            arg if cli::is_help(&arg) => return Ok(None),
+            arg => return Err(arg.unexpected()),
+        }
+    }
+    Ok(Some(cycles.unwrap_or_else(|| DEFAULT_CYCLES.to_string())))
 }
 
 /// `cycles` cycles under valgrind, the example built with `cargo_args` added
