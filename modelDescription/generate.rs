@@ -1,7 +1,7 @@
 //! Generator of everything derived from `variables.toml`, the one table of
 //! the FMU's variables. Shared by `build.rs` (the Rust variable table and
 //! enumerations), `cargo xtask fmu` (documentation/index.html,
-//! resources/startValues.txt), `cargo xtask docs` (the README's tables) and
+//! resources/startValues.txt), `cargo xtask docs` (docs/variables.md's tables) and
 //! `tests/fmi_model_description.rs`, all through this file, so the XML and
 //! the value references of the binary cannot drift.
 //!

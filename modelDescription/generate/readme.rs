@@ -1,4 +1,4 @@
-//! The README's Markdown tables of the variables, the enumerations and the
+//! The Markdown tables of docs/variables.md: the variables, the enumerations and the
 //! canonical scenes (`cargo xtask docs`).
 
 use std::collections::BTreeMap;
@@ -6,12 +6,12 @@ use std::fmt::Write as _;
 
 use super::{Dim, Spec};
 
-/// Markers of the generated tables in README.md.
+/// Markers of the generated tables in docs/variables.md.
 pub const README_BEGIN: &str = "<!-- variables: generated from modelDescription/variables.toml by `cargo xtask docs` -->";
 pub const README_END: &str = "<!-- end of generated variables -->";
 
 impl Spec {
-    /// The README's tables of the variables, the enumerations and the
+    /// docs/variables.md's tables of the variables, the enumerations and the
     /// canonical scenes (Markdown), written by `cargo xtask docs` between
     /// the markers [`README_BEGIN`] and [`README_END`].
     pub fn readme_tables(&self) -> String {

@@ -1,4 +1,4 @@
-//! `cargo xtask docs`: writes the README's tables of the variables, the
+//! `cargo xtask docs`: writes docs/variables.md's tables of the variables, the
 //! enumerations and the canonical scenes from modelDescription/variables.toml,
 //! between the markers `tests/fmi_model_description.rs` checks.
 
@@ -13,16 +13,16 @@ pub fn main(args: &[String]) -> Result<(), String> {
     }
     let root = crate::setup::root();
     let spec = generate::load(&root.join("modelDescription/variables.toml"))?;
-    let path = root.join("README.md");
+    let path = root.join("docs/variables.md");
     let readme = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let (head, rest) = readme.split_once(README_BEGIN).ok_or(format!("README.md has no line {README_BEGIN}"))?;
-    let (_, tail) = rest.split_once(README_END).ok_or(format!("README.md has no line {README_END}"))?;
+    let (head, rest) = readme.split_once(README_BEGIN).ok_or(format!("docs/variables.md has no line {README_BEGIN}"))?;
+    let (_, tail) = rest.split_once(README_END).ok_or(format!("docs/variables.md has no line {README_END}"))?;
     let new = format!("{head}{README_BEGIN}\n{}{README_END}{tail}", spec.readme_tables());
     if new != readme {
         std::fs::write(&path, new).map_err(|e| format!("{}: {e}", path.display()))?;
-        println!("README.md: variable tables written");
+        println!("docs/variables.md: variable tables written");
     } else {
-        println!("README.md: variable tables up to date");
+        println!("docs/variables.md: variable tables up to date");
     }
     Ok(())
 }

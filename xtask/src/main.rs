@@ -37,7 +37,7 @@ const TASKS: [(&str, Task, &str); 11] = [
     ("fuzz", fuzz::main, "the cargo-fuzz targets for a bounded time (--seconds N)"),
     ("valgrind", valgrind::main, "leak check of instantiate/step/serialize/free cycles"),
     ("stability", stability::main, "the stability matrix, its table written into docs/stability.md"),
-    ("docs", docs::main, "the variable tables of the README, from modelDescription/variables.toml"),
+    ("docs", docs::main, "the variable tables of docs/variables.md, from modelDescription/variables.toml"),
 ];
 
 fn usage() -> String {
