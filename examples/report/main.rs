@@ -86,7 +86,7 @@ fn main() {
         c
     };
     if !only.is_empty() {
-        cases.retain(|c| only.iter().any(|o| *o == c.label));
+        cases.retain(|c| only.contains(&c.label));
     }
     std::fs::create_dir_all(&out).expect("cannot create the output folder");
 

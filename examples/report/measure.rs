@@ -13,6 +13,9 @@ use crate::plan::{full_solver, Plan, SceneCase, Variant, FRAME, REFERENCE_MARGIN
 use crate::row::{describe, Row};
 use crate::run::{run, set_up, simulate, Prepared};
 
+/// A modal configuration set up once for all its steps: (scheme, modes, variant).
+type Configuration = (Integrator, usize, usize);
+
 /// What every scene's runs share.
 pub struct Conditions<'a> {
     /// Simulated time of each run [s].
@@ -62,7 +65,7 @@ pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, referenc
     // runs are those of separate set-ups; only the refusal of a scheme too
     // stiff for its bound depends on it, and such a set-up is redone per step.
     let mut order: Vec<usize> = (0..list.len()).filter(|&i| list[i].solver.reduction == Reduction::Full).collect();
-    let mut groups: Vec<((Integrator, usize, usize), Vec<usize>)> = Vec::new();
+    let mut groups: Vec<(Configuration, Vec<usize>)> = Vec::new();
     for (i, plan) in list.iter().enumerate().filter(|(_, p)| p.solver.reduction == Reduction::Modal) {
         let key = (plan.solver.integrator, plan.solver.n_modes, plan.variant);
         match groups.iter_mut().find(|(k, _)| *k == key) {
@@ -72,7 +75,7 @@ pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, referenc
     }
     order.extend(groups.iter().flat_map(|(_, g)| g.iter().copied()));
     let mut slots: Vec<Option<(Row, Vec<f64>)>> = (0..list.len()).map(|_| None).collect();
-    let mut prepared: Option<((Integrator, usize, usize), Result<Prepared, PhysicsError>)> = None;
+    let mut prepared: Option<(Configuration, Result<Prepared, PhysicsError>)> = None;
     for &i in &order {
         let plan = &list[i];
         let s = &plan.solver;
