@@ -6,12 +6,26 @@ use std::time::Instant;
 
 use modal_mass_spring::fmi::{bake, model::Params};
 
+/// The two paths of the command line.
+fn parse_args() -> Result<(String, String), lexopt::Error> {
+    use lexopt::prelude::*;
+    let mut paths = Vec::new();
+    let mut parser = lexopt::Parser::from_env();
+    while let Some(arg) = parser.next()? {
+        match arg {
+            Value(v) if paths.len() < 2 => paths.push(v.string()?),
+            _ => return Err(arg.unexpected()),
+        }
+    }
+    let [start, out]: [String; 2] = paths.try_into().map_err(|_| "START_VALUES_TXT and OUT_BIN are both needed")?;
+    Ok((start, out))
+}
+
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let [_, start, out] = &args[..] else {
-        eprintln!("usage: bake START_VALUES_TXT OUT_BIN");
-        std::process::exit(2);
-    };
+    let (start, out) = &parse_args().unwrap_or_else(|e| {
+        eprintln!("bake: {e}\nusage: bake START_VALUES_TXT OUT_BIN");
+        std::process::exit(2)
+    });
     let text = std::fs::read_to_string(start).unwrap_or_else(|e| panic!("{start}: {e}"));
     let params = Params::from_text(&text).unwrap_or_else(|e| panic!("{start}: {e}"));
     let t = Instant::now();

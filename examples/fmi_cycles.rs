@@ -115,8 +115,24 @@ unsafe fn cycle(i: usize, counts: &mut [usize; 5]) {
     check("call after free", fmi3Reset(inst), ERROR);
 }
 
+fn parse_args() -> Result<usize, lexopt::Error> {
+    use lexopt::prelude::*;
+    let mut cycles = None;
+    let mut parser = lexopt::Parser::from_env();
+    while let Some(arg) = parser.next()? {
+        match arg {
+            Value(v) if cycles.is_none() => cycles = Some(v.parse()?),
+            _ => return Err(arg.unexpected()),
+        }
+    }
+    Ok(cycles.unwrap_or(16))
+}
+
 fn main() {
-    let cycles: usize = std::env::args().nth(1).map_or(16, |a| a.parse().expect("CYCLES must be a number"));
+    let cycles = parse_args().unwrap_or_else(|e| {
+        eprintln!("fmi_cycles: {e}\nusage: fmi_cycles [CYCLES]");
+        std::process::exit(2)
+    });
     let mut counts = [0usize; 5];
     for i in 0..cycles {
         unsafe { cycle(i, &mut counts) };

@@ -19,43 +19,55 @@ use modal_mass_spring::physics::basis::{self, BasisOptions};
 use modal_mass_spring::physics::{Integrator, ModeSelection, Reduction, Simulator, SolverParams};
 use modal_mass_spring::scenes;
 
-fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let mut sizes = Vec::new();
-    let mut modes = 30;
-    let mut corrections = vec![false, true];
-    let mut selections = vec![ModeSelection::Lowest, ModeSelection::Load];
-    let mut i = 0;
-    while i < args.len() {
-        match args[i].as_str() {
-            "--modes" => {
-                i += 1;
-                modes = args.get(i).and_then(|s| s.parse().ok()).expect("--modes takes a number");
-            }
-            "--no-correction" => corrections = vec![false],
-            "--only-correction" => corrections = vec![true],
-            "--lowest" => selections = vec![ModeSelection::Lowest],
-            "--load" => selections = vec![ModeSelection::Load],
-            s => sizes.push(s.parse::<usize>().unwrap_or_else(|_| panic!("{s}: sizes are numbers of nodes per side"))),
+struct Args {
+    sizes: Vec<usize>,
+    modes: usize,
+    corrections: Vec<bool>,
+    selections: Vec<ModeSelection>,
+}
+
+fn parse_args() -> Result<Args, lexopt::Error> {
+    use lexopt::prelude::*;
+    let mut args = Args { sizes: Vec::new(), modes: 30, corrections: vec![false, true], selections: ModeSelection::ALL.to_vec() };
+    let mut parser = lexopt::Parser::from_env();
+    while let Some(arg) = parser.next()? {
+        match arg {
+            Long("modes") => args.modes = parser.value()?.parse()?,
+            Long("no-correction") => args.corrections = vec![false],
+            Long("only-correction") => args.corrections = vec![true],
+            Long("lowest") => args.selections = vec![ModeSelection::Lowest],
+            Long("load") => args.selections = vec![ModeSelection::Load],
+            Value(v) => args.sizes.push(v.parse()?),
+            _ => return Err(arg.unexpected()),
         }
-        i += 1;
     }
-    if sizes.is_empty() {
-        sizes = vec![30, 50, 100, 200, 300];
+    if args.sizes.is_empty() {
+        args.sizes = vec![30, 50, 100, 200, 300];
     }
+    Ok(args)
+}
+
+/// The solver settings of every case.
+fn solver(modes: usize, selection: ModeSelection, static_correction: bool) -> SolverParams {
+    let mut solver = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, modes);
+    solver.basis = BasisOptions { selection, static_correction, ..BasisOptions::default() };
+    solver
+}
+
+fn main() {
+    let Args { sizes, modes, corrections, selections } = parse_args().unwrap_or_else(|e| {
+        eprintln!("setup_vs_mesh: {e} (sizes are numbers of nodes per side)");
+        eprintln!("usage: setup_vs_mesh [n...] [--modes r] [--lowest | --load] [--no-correction | --only-correction]");
+        std::process::exit(2)
+    });
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!("cloth-3d, n x n nodes, {modes} modes, {threads} threads available");
     println!("{:>5} {:>8} {:>7} {:>10} {:>8} {:>8} {:>8} {:>10}", "n", "dofs", "select", "correction", "basis_s", "setup_s", "other_s", "omega_1");
     for &n in &sizes {
         for &selection in &selections {
             for &static_correction in &corrections {
-                let mut solver = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, modes);
-                solver.basis = BasisOptions { selection, static_correction, ..BasisOptions::default() };
-                let setup = scenes::cloth(n, n).with_solver(solver);
-                let select = match selection {
-                    ModeSelection::Lowest => "lowest",
-                    ModeSelection::Load => "load",
-                };
+                let setup = scenes::cloth(n, n).with_solver(solver(modes, selection, static_correction));
+                let select = selection.name();
                 let correction = if static_correction { "static" } else { "none" };
                 let scene = setup.grid.build().expect("cloth scene");
                 let dofs = scene.n_dofs();

@@ -8,6 +8,7 @@
 //! `docs/method.md` is the method, `docs/architecture.md` the shape of the code.
 
 pub mod fmi;
+pub mod measures;
 pub mod options;
 pub mod physics;
 pub mod scenes;

@@ -7,6 +7,7 @@ mod common;
 
 use common::*;
 use modal_mass_spring::fmi::variables::vr;
+use modal_mass_spring::measures::{trajectory_error, Masses};
 use modal_mass_spring::physics::*;
 use modal_mass_spring::scenes;
 
@@ -84,18 +85,6 @@ fn cubature_reproduces_the_projected_force_on_held_out_poses() {
     }
 }
 
-/// E of docs/method.md, section 6, of `run` against `reference` (frames of node positions).
-fn trajectory_error(run: &[Vec<f64>], reference: &[Vec<f64>]) -> f64 {
-    let (mut num, mut den) = (0.0, 0.0);
-    for (x, xr) in run.iter().zip(reference) {
-        for i in 0..x.len() {
-            num += (x[i] - xr[i]).powi(2);
-            den += (xr[i] - reference[0][i]).powi(2);
-        }
-    }
-    (num / den).sqrt()
-}
-
 #[test]
 fn cubature_runs_follow_exact_forces_with_both_integrators() {
     let setup = scenes::canonical("paper-2d-top-row").unwrap();
@@ -111,7 +100,8 @@ fn cubature_runs_follow_exact_forces_with_both_integrators() {
             }
             out
         };
-        let e = trajectory_error(&frames(ForceEvaluation::Cubature), &frames(ForceEvaluation::Exact));
+        let exact = frames(ForceEvaluation::Exact);
+        let e = trajectory_error(&frames(ForceEvaluation::Cubature), &exact, &exact[0], Masses::Equal);
         eprintln!("{integrator:?}: E(cubature, exact) = {e:.2e} over 2 s");
         assert!(e <= 0.01, "{integrator:?}: E(cubature, exact) = {e}");
     }

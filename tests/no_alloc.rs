@@ -60,11 +60,8 @@ fn do_step_allocates_nothing() {
         (equilibrium, cubature),
     ];
     for name in ["paper-2d-top-row", "paper-3d-sheet"] {
-        for reduction in [Reduction::Modal, Reduction::Full] {
-            for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit, Integrator::Trigonometric] {
-                if integrator == Integrator::Trigonometric && reduction == Reduction::Full {
-                    continue; // refused at set-up
-                }
+        for &reduction in Reduction::ALL {
+            for &integrator in Integrator::ALL {
                 for (basis, force) in if reduction == Reduction::Modal { &options[..] } else { &options[..1] } {
                     let mut solver = SolverParams::new(reduction, integrator, 4);
                     solver.basis = basis.clone();
@@ -73,7 +70,12 @@ fn do_step_allocates_nothing() {
                     setup.loads.damping_beta = 1e-3; // exercises the factorised explicit velocity update too
                                                      // A point load on the load node of the scene (a load pattern of the basis options too).
                     setup.loads.point_load = [0.01, -0.02, 0.0];
-                    let mut sim = setup.simulator().unwrap();
+                    let mut sim = match setup.simulator() {
+                        Ok(sim) => sim,
+                        // A space the scheme refuses at set-up (the trigonometric scheme in full space).
+                        Err(PhysicsError::SchemeNeedsDiagonal { .. }) if reduction != Reduction::Modal => continue,
+                        Err(e) => panic!("{name} {reduction:?} {integrator:?}: {e}"),
+                    };
                     sim.do_step(0.01).unwrap(); // first step may factorise
                     let mut loads = sim.loads().clone();
                     let before = ALLOCATIONS.load(Ordering::SeqCst);

@@ -27,6 +27,7 @@ use common::*;
 use fmi_sys::fmi3::*;
 use modal_mass_spring::fmi::exports::*;
 use modal_mass_spring::fmi::variables::vr;
+use modal_mass_spring::measures::{trajectory_error, Masses};
 
 /// Largest |E(t) - E(t0)| of a stable cell, relative to the largest kinetic
 /// energy since t0 (t0: start, or the last change of gravity): the energy
@@ -570,17 +571,6 @@ fn run_cell(e: &Extreme, s: &SceneDef, modal: bool, integrator: i64) -> Cell {
     Cell { outcome: Outcome::Stable { drift, stretch: max_stretch, warned }, samples, initial }
 }
 
-/// E of docs/method.md, section 6 (equal node masses cancel).
-fn trajectory_error(run: &[Vec<f64>], reference: &[Vec<f64>], x0: &[f64]) -> f64 {
-    let mut num = 0.0;
-    let mut den = 0.0;
-    for (a, b) in run.iter().zip(reference) {
-        num += a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>();
-        den += b.iter().zip(x0).map(|(x, y)| (x - y) * (x - y)).sum::<f64>();
-    }
-    (num / den).sqrt()
-}
-
 fn short(o: &Outcome) -> String {
     match o {
         Outcome::Stable { .. } => "stable".into(),
@@ -650,7 +640,7 @@ fn stability_matrix() {
                             text += &format!(" · stretch {:.0} %", stretch * 100.0);
                             let full = cell(ei, si, partner);
                             if modal && matches!(full.outcome, Outcome::Stable { .. }) {
-                                text += &format!(" · E vs full {:.2}", trajectory_error(&x.samples, &full.samples, &full.initial));
+                                text += &format!(" · E vs full {:.2}", trajectory_error(&x.samples, &full.samples, &full.initial, Masses::Equal));
                             }
                         }
                     }
