@@ -30,14 +30,14 @@ const PER_CALL: usize = 100;
 
 /// A simulator whose internal step is `dt` whatever the call length, or
 /// the set-up's refusal.
-fn try_simulator(p: &Grid, s: &SolverParams) -> Result<(Simulator, f64), PhysicsError> {
+fn try_simulator(p: &Grid, s: &Settings) -> Result<(Simulator, f64), PhysicsError> {
     let probe = Simulator::new(p.build()?, s, &Loads::physical(s.n_modes))?;
     let dt = probe.max_stable_step().min(1e-4);
-    let fixed = SolverParams { max_internal_step: dt, ..s.clone() };
+    let fixed = Settings { max_internal_step: dt, ..s.clone() };
     Ok((Simulator::new(p.build()?, &fixed, &Loads::physical(s.n_modes))?, dt))
 }
 
-fn simulator(p: &Grid, s: &SolverParams) -> (Simulator, f64) {
+fn simulator(p: &Grid, s: &Settings) -> (Simulator, f64) {
     try_simulator(p, s).unwrap()
 }
 
@@ -47,9 +47,9 @@ fn internal_step(c: &mut Criterion) {
         let n = p.build().unwrap().n_dofs();
         let mut group = c.benchmark_group(format!("internal_step/{name}"));
         for &integrator in Integrator::ALL {
-            let mut configs: Vec<(String, SolverParams)> =
-                [2usize, 8, 32].into_iter().filter(|&r| r <= n).map(|r| (format!("modal-r{r}"), SolverParams::new(Reduction::Modal, integrator, r))).collect();
-            configs.push(("full".into(), SolverParams::new(Reduction::Full, integrator, 0)));
+            let mut configs: Vec<(String, Settings)> =
+                [2usize, 8, 32].into_iter().filter(|&r| r <= n).map(|r| (format!("modal-r{r}"), Settings::new(Reduction::Modal, integrator, r))).collect();
+            configs.push(("full".into(), Settings::new(Reduction::Full, integrator, 0)));
             for (label, s) in configs {
                 let (mut sim, dt) = match try_simulator(&p, &s) {
                     Ok(built) => built,
@@ -81,12 +81,13 @@ fn cubature(c: &mut Criterion) {
         let mut group = c.benchmark_group(format!("cubature/cloth-3d-{n}x{n}"));
         group.sample_size(20);
         for &evaluation in ForceEvaluation::ALL {
-            let mut s = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 16);
-            s.basis = BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest, anchor_motion: false };
-            s.force = ForceOptions { evaluation, cubature_tolerance: 0.01 };
-            let probe = setup.with_solver(s.clone()).simulator().unwrap();
+            let mut s = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 16);
+            s.mode_selection = ModeSelection::Load;
+            s.static_correction = true;
+            s.force_evaluation = evaluation;
+            let probe = setup.with_settings(s.clone()).simulator().unwrap();
             let dt = probe.max_stable_step().min(1e-3);
-            let mut sim = setup.with_solver(SolverParams { max_internal_step: dt, ..s }).simulator().unwrap();
+            let mut sim = setup.with_settings(Settings { max_internal_step: dt, ..s }).simulator().unwrap();
             let springs = sim.cubature_springs();
             group.bench_function(BenchmarkId::new(format!("{evaluation:?}"), format!("{springs} springs")), |b| {
                 b.iter_custom(|iters| {
@@ -108,7 +109,7 @@ unsafe extern "C" fn silent(_: fmi3InstanceEnvironment, _: fmi3Status, _: fmi3St
 fn do_step(c: &mut Criterion) {
     let name = "paper-2d-top-row";
     let p = scenes::canonical(name).unwrap().grid;
-    let s = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, 2);
+    let s = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 2);
     let (mut many, dt) = simulator(&p, &s);
     let (mut one, _) = simulator(&p, &s);
     let mut group = c.benchmark_group(format!("do_step/{name}"));

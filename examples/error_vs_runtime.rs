@@ -21,16 +21,9 @@ struct Run {
 }
 
 /// The solver settings of every run: `n_modes` modes, or full space for `None`.
-fn solver(integrator: Integrator, n_modes: Option<usize>, max_internal_step: f64) -> SolverParams {
-    SolverParams {
-        reduction: if n_modes.is_some() { Reduction::Modal } else { Reduction::Full },
-        integrator,
-        n_modes: n_modes.unwrap_or(0),
-        max_internal_step,
-        substepping: true,
-        basis: BasisOptions::default(),
-        force: ForceOptions::default(),
-    }
+fn solver(integrator: Integrator, n_modes: Option<usize>, max_internal_step: f64) -> Settings {
+    let reduction = if n_modes.is_some() { Reduction::Modal } else { Reduction::Full };
+    Settings { max_internal_step, ..Settings::new(reduction, integrator, n_modes.unwrap_or(0)) }
 }
 
 fn parse_args() -> Result<(String, f64), lexopt::Error> {
@@ -47,7 +40,7 @@ fn parse_args() -> Result<(String, f64), lexopt::Error> {
     Ok((name.unwrap_or_else(|| "paper-2d-top-row".into()), seconds.unwrap_or(2.0)))
 }
 
-fn simulate(p: &Grid, s: &SolverParams, h: f64, frame_every: usize, frames: usize) -> Result<Run, PhysicsError> {
+fn simulate(p: &Grid, s: &Settings, h: f64, frame_every: usize, frames: usize) -> Result<Run, PhysicsError> {
     let t0 = Instant::now();
     let mut sim = Simulator::new(p.build()?, s, &Loads::physical(s.n_modes))?;
     let setup_s = t0.elapsed().as_secs_f64();

@@ -15,8 +15,8 @@
 
 use std::time::Instant;
 
-use modal_mass_spring::physics::basis::{self, BasisOptions};
-use modal_mass_spring::physics::{Integrator, ModeSelection, Reduction, Simulator, SolverParams};
+use modal_mass_spring::physics::basis;
+use modal_mass_spring::physics::{Integrator, ModeSelection, Reduction, Settings, Simulator};
 use modal_mass_spring::scenes;
 
 struct Args {
@@ -48,9 +48,10 @@ fn parse_args() -> Result<Args, lexopt::Error> {
 }
 
 /// The solver settings of every case.
-fn solver(modes: usize, selection: ModeSelection, static_correction: bool) -> SolverParams {
-    let mut solver = SolverParams::new(Reduction::Modal, Integrator::NewmarkExplicit, modes);
-    solver.basis = BasisOptions { selection, static_correction, ..BasisOptions::default() };
+fn solver(modes: usize, selection: ModeSelection, static_correction: bool) -> Settings {
+    let mut solver = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, modes);
+    solver.mode_selection = selection;
+    solver.static_correction = static_correction;
     solver
 }
 
@@ -66,13 +67,13 @@ fn main() {
     for &n in &sizes {
         for &selection in &selections {
             for &static_correction in &corrections {
-                let setup = scenes::cloth(n, n).with_solver(solver(modes, selection, static_correction));
+                let setup = scenes::cloth(n, n).with_settings(solver(modes, selection, static_correction));
                 let select = selection.name();
                 let correction = if static_correction { "static" } else { "none" };
                 let scene = setup.grid.build().expect("cloth scene");
                 let dofs = scene.n_dofs();
                 let t0 = Instant::now();
-                let built = basis::build(&scene, &setup.loads, modes, &setup.solver.basis);
+                let built = basis::build(&scene, &setup.loads, modes, &setup.settings);
                 let basis_s = t0.elapsed().as_secs_f64();
                 let omega_1 = match built {
                     Ok(b) => b.modes.frequencies()[0],
@@ -82,7 +83,7 @@ fn main() {
                     }
                 };
                 let t1 = Instant::now();
-                let sim = Simulator::new(scene, &setup.solver, &setup.loads);
+                let sim = Simulator::new(scene, &setup.settings, &setup.loads);
                 let setup_s = t1.elapsed().as_secs_f64();
                 match sim {
                     Ok(_) => println!("{n:>5} {dofs:>8} {select:>7} {correction:>10} {basis_s:>8.3} {setup_s:>8.3} {:>8.3} {omega_1:>10.6}", setup_s - basis_s),

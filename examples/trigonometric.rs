@@ -26,24 +26,18 @@ struct Run {
     internal_steps: usize,
 }
 
-fn load_static() -> BasisOptions {
-    BasisOptions { selection: ModeSelection::Load, static_correction: true, linearization: Linearization::Rest, anchor_motion: false }
-}
-
-fn solver(reduction: Reduction, integrator: Integrator, n_modes: usize, max_internal_step: f64) -> SolverParams {
-    SolverParams {
-        reduction,
-        integrator,
-        n_modes,
-        max_internal_step,
-        substepping: true,
-        basis: if reduction == Reduction::Modal { load_static() } else { BasisOptions::default() },
-        force: ForceOptions::default(),
+fn solver(reduction: Reduction, integrator: Integrator, n_modes: usize, max_internal_step: f64) -> Settings {
+    let settings = Settings { max_internal_step, ..Settings::new(reduction, integrator, n_modes) };
+    if reduction == Reduction::Modal {
+        // Load modes with a static correction, at rest.
+        Settings { mode_selection: ModeSelection::Load, static_correction: true, ..settings }
+    } else {
+        settings
     }
 }
 
 /// Node positions after every communication step `h` (frames every `every` steps), from t = 0 to `seconds`.
-fn simulate(p: &Grid, s: &SolverParams, h: f64, every: usize, seconds: f64) -> Result<Run, PhysicsError> {
+fn simulate(p: &Grid, s: &Settings, h: f64, every: usize, seconds: f64) -> Result<Run, PhysicsError> {
     let mut sim = Simulator::new(p.build()?, s, &Loads::physical(s.n_modes))?;
     let n = (seconds / h).round() as usize;
     let mut frames = vec![sim.positions().to_vec()];

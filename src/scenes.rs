@@ -6,29 +6,29 @@ use crate::fmi::model::Params;
 use crate::fmi::variables::{scene_names, vr};
 use crate::physics::{Grid, Loads, PhysicsError, Settings, Simulator};
 
-/// Grid, solver and loads of one set-up.
+/// Grid, settings and loads of one set-up.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Setup {
     pub grid: Grid,
-    pub solver: Settings,
+    pub settings: Settings,
     pub loads: Loads,
 }
 
 impl Setup {
     /// The set-up of the FMU with these variable values.
     pub fn from_params(p: &Params) -> Self {
-        Setup { grid: p.grid(), solver: p.settings(), loads: p.loads() }
+        Setup { grid: p.grid(), settings: p.settings(), loads: p.loads() }
     }
 
-    /// The same set-up with `solver`, and loads sized to its modes (every weight 1).
-    pub fn with_settings(&self, solver: Settings) -> Self {
-        let loads = Loads { mode_weights: vec![1.0; solver.n_modes], ..self.loads.clone() };
-        Setup { grid: self.grid.clone(), solver, loads }
+    /// The same set-up with `settings`, and loads sized to its modes (every weight 1).
+    pub fn with_settings(&self, settings: Settings) -> Self {
+        let loads = Loads { mode_weights: vec![1.0; settings.n_modes], ..self.loads.clone() };
+        Setup { grid: self.grid.clone(), settings, loads }
     }
 
     /// Builds the scene and the simulator.
     pub fn simulator(&self) -> Result<Simulator, PhysicsError> {
-        Simulator::new(self.grid.build()?, &self.solver, &self.loads)
+        Simulator::new(self.grid.build()?, &self.settings, &self.loads)
     }
 }
 

@@ -10,7 +10,7 @@ mod common;
 
 use common::*;
 use modal_mass_spring::fmi::variables::vr;
-use modal_mass_spring::physics::engine::{Engine, Probe, Stepper};
+use modal_mass_spring::physics::engine::{Engine, Stepper};
 use modal_mass_spring::physics::error::StepFailure;
 use modal_mass_spring::physics::integrator::{Propagator, Trigonometric};
 use modal_mass_spring::physics::space::{Diagonal, Layout, Readout, Space};

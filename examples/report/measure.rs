@@ -93,7 +93,7 @@ pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, referenc
                 drop(prepared.take()); // frees the last configuration's basis first
                 let group = &groups.iter().find(|(k, _)| *k == key).unwrap().1;
                 let longest = group.iter().filter(|&&j| !list[j].note.starts_with("not run")).map(|&j| list[j].step).fold(plan.step, f64::max);
-                prepared = Some((key, set_up(p, &SolverParams { max_internal_step: longest, ..s.clone() })));
+                prepared = Some((key, set_up(p, &Settings { max_internal_step: longest, ..s.clone() })));
             }
             match &mut prepared.as_mut().unwrap().1 {
                 Ok(prep) => run(prep, plan.step, seconds, budget_s, repeats),

@@ -22,8 +22,10 @@ pub struct Variant {
     pub key: &'static str,
     /// Name in the report.
     pub label: &'static str,
-    pub basis: BasisOptions,
-    pub force: ForceOptions,
+    /// The basis and force choices (mode selection, static correction,
+    /// linearization, force evaluation); each run sets its space, scheme,
+    /// modes and step.
+    pub settings: Settings,
 }
 
 /// Index of the paper's method in [`variants`].
@@ -33,20 +35,29 @@ pub const LOAD_STATIC: usize = 2;
 
 /// The paper's method first, then every other option the study compares with it.
 pub fn variants() -> Vec<Variant> {
+    use ForceEvaluation::{Cubature, Exact};
     use Linearization::{Equilibrium, Rest};
     use ModeSelection::{Load, Lowest};
-    let basis = |selection, static_correction, linearization| BasisOptions { selection, static_correction, linearization, anchor_motion: false };
-    let exact = ForceOptions { evaluation: ForceEvaluation::Exact, cubature_tolerance: CUBATURE_TOLERANCE };
-    let cubature = ForceOptions { evaluation: ForceEvaluation::Cubature, cubature_tolerance: CUBATURE_TOLERANCE };
-    let v = |key, label, basis, force| Variant { key, label, basis, force };
+    let v = |key, label, mode_selection, static_correction, linearization, force_evaluation| Variant {
+        key,
+        label,
+        settings: Settings {
+            mode_selection,
+            static_correction,
+            linearization,
+            force_evaluation,
+            cubature_tolerance: CUBATURE_TOLERANCE,
+            ..Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 0)
+        },
+    };
     vec![
-        v("paper", "paper (lowest modes at rest)", basis(Lowest, false, Rest), exact.clone()),
-        v("load", "load", basis(Load, false, Rest), exact.clone()),
-        v("load+static", "load + static correction", basis(Load, true, Rest), exact.clone()),
-        v("load+static@equilibrium", "load + static correction @ equilibrium", basis(Load, true, Equilibrium), exact),
-        v("load+cubature", "load + cubature", basis(Load, false, Rest), cubature.clone()),
-        v("load+static+cubature", "load + static correction + cubature", basis(Load, true, Rest), cubature.clone()),
-        v("load+static@equilibrium+cubature", "load + static correction @ equilibrium + cubature", basis(Load, true, Equilibrium), cubature),
+        v("paper", "paper (lowest modes at rest)", Lowest, false, Rest, Exact),
+        v("load", "load", Load, false, Rest, Exact),
+        v("load+static", "load + static correction", Load, true, Rest, Exact),
+        v("load+static@equilibrium", "load + static correction @ equilibrium", Load, true, Equilibrium, Exact),
+        v("load+cubature", "load + cubature", Load, false, Rest, Cubature),
+        v("load+static+cubature", "load + static correction + cubature", Load, true, Rest, Cubature),
+        v("load+static@equilibrium+cubature", "load + static correction @ equilibrium + cubature", Load, true, Equilibrium, Cubature),
     ]
 }
 
@@ -56,7 +67,7 @@ pub struct SceneCase {
 }
 
 pub struct Plan {
-    pub solver: SolverParams,
+    pub solver: Settings,
     pub variant: usize,
     pub step: f64,
     pub step_label: String,
@@ -77,20 +88,12 @@ pub fn tangent_note(integrator: Integrator, springs: usize, r: usize) -> String 
     }
 }
 
-pub fn full_solver(integrator: Integrator, max_internal_step: f64) -> SolverParams {
-    SolverParams {
-        reduction: Reduction::Full,
-        integrator,
-        n_modes: 0,
-        max_internal_step,
-        substepping: true,
-        basis: BasisOptions::default(),
-        force: ForceOptions::default(),
-    }
+pub fn full_solver(integrator: Integrator, max_internal_step: f64) -> Settings {
+    Settings { max_internal_step, ..Settings::new(Reduction::Full, integrator, 0) }
 }
 
-pub fn modal_solver(integrator: Integrator, n_modes: usize, max_internal_step: f64, v: &Variant) -> SolverParams {
-    SolverParams { reduction: Reduction::Modal, integrator, n_modes, max_internal_step, substepping: true, basis: v.basis.clone(), force: v.force.clone() }
+pub fn modal_solver(integrator: Integrator, n_modes: usize, max_internal_step: f64, v: &Variant) -> Settings {
+    Settings { integrator, n_modes, max_internal_step, ..v.settings.clone() }
 }
 
 /// Scenes with more free DOFs than this get the variants' smallest grid.
@@ -121,8 +124,8 @@ pub fn variant_grid(n: usize, v: &Variant) -> Vec<(usize, Integrator, usize)> {
             }
         }
     } else {
-        let at_equilibrium = v.basis.linearization == Linearization::Equilibrium;
-        let cubature = v.force.evaluation == ForceEvaluation::Cubature;
+        let at_equilibrium = v.settings.linearization == Linearization::Equilibrium;
+        let cubature = v.settings.force_evaluation == ForceEvaluation::Cubature;
         let counts: &[usize] = match (at_equilibrium, cubature) {
             (false, _) => &[2, 8, 32],
             (true, false) => &[32],

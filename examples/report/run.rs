@@ -37,7 +37,7 @@ pub struct Prepared {
     pub setup_s: f64,
 }
 
-pub fn set_up(p: &Grid, s: &SolverParams) -> Result<Prepared, PhysicsError> {
+pub fn set_up(p: &Grid, s: &Settings) -> Result<Prepared, PhysicsError> {
     let t0 = Instant::now();
     let sim = Simulator::new(p.build()?, s, &Loads::physical(s.n_modes))?;
     let setup_s = t0.elapsed().as_secs_f64();
@@ -100,6 +100,6 @@ pub fn run(prep: &mut Prepared, h: f64, seconds: f64, budget_s: f64, repeats: us
 }
 
 /// Sets up and runs.
-pub fn simulate(p: &Grid, s: &SolverParams, h: f64, seconds: f64, budget_s: f64, repeats: usize) -> Result<Trajectory, String> {
+pub fn simulate(p: &Grid, s: &Settings, h: f64, seconds: f64, budget_s: f64, repeats: usize) -> Result<Trajectory, String> {
     run(&mut set_up(p, s).map_err(|e| e.to_string())?, h, seconds, budget_s, repeats)
 }

@@ -78,12 +78,12 @@ pub fn write_readme(out: &str, study: &Study, reference_notes: &str) {
             "| {} (`{}`) | {} | {} | {} | {} |",
             v.label,
             v.key,
-            v.basis.selection.name(),
-            if v.basis.static_correction { "yes" } else { "no" },
-            v.basis.linearization.name(),
-            match v.force.evaluation {
+            v.settings.mode_selection.name(),
+            if v.settings.static_correction { "yes" } else { "no" },
+            v.settings.linearization.name(),
+            match v.settings.force_evaluation {
                 ForceEvaluation::Exact => "every spring".to_string(),
-                ForceEvaluation::Cubature => format!("cubature, tolerance {}", v.force.cubature_tolerance),
+                ForceEvaluation::Cubature => format!("cubature, tolerance {}", v.settings.cubature_tolerance),
             }
         );
     }
