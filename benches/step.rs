@@ -54,7 +54,7 @@ fn internal_step(c: &mut Criterion) {
                 let (mut sim, dt) = match try_simulator(&p, &s) {
                     Ok(built) => built,
                     // A space the scheme cannot integrate (the trigonometric scheme in full space).
-                    Err(PhysicsError::SchemeNeedsDiagonal { .. }) => continue,
+                    Err(e) if e.refuses_pairing() => continue,
                     Err(e) => panic!("{name} {integrator:?} {label}: {e}"),
                 };
                 let h = dt * PER_CALL as f64 * (1.0 - 1e-9);

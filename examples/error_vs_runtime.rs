@@ -94,7 +94,7 @@ fn main() {
                 );
             }
             // A space the scheme cannot integrate: not a run.
-            Err(PhysicsError::SchemeNeedsDiagonal { .. }) => {}
+            Err(e) if e.refuses_pairing() => {}
             Err(e) => println!("{:?} {:?} r={}: {e}", s.reduction, s.integrator, s.n_modes),
         }
     }

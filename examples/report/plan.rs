@@ -152,7 +152,7 @@ pub fn variant_grid(n: usize, v: &Variant) -> Vec<(usize, Integrator, usize)> {
 /// Whether full space refuses `integrator` at set-up (a scheme that needs
 /// the modal space's diagonal mass and stiffness, as the trigonometric one).
 fn modal_only(scene: &Scene, integrator: Integrator) -> bool {
-    matches!(Simulator::new(scene.clone(), &full_solver(integrator, 1.0), &Loads::physical(0)), Err(PhysicsError::SchemeNeedsDiagonal { .. }))
+    Simulator::new(scene.clone(), &full_solver(integrator, 1.0), &Loads::physical(0)).is_err_and(|e| e.refuses_pairing())
 }
 
 /// Every way of running the scene `p` (`quick`: the CI's smaller grid;

@@ -236,6 +236,15 @@ pub enum PhysicsError {
     SnapshotNotFinite,
 }
 
+impl PhysicsError {
+    /// The set-up refused the pairing of a space and a scheme, whatever the
+    /// scene and the numbers (a scheme's [`check`](crate::physics::integrator::Scheme::check)):
+    /// what tests, benchmarks and the study skip when they run every pair.
+    pub fn refuses_pairing(&self) -> bool {
+        matches!(self, PhysicsError::SchemeNeedsDiagonal { .. })
+    }
+}
+
 /// The space of [`PhysicsError::ExplicitTooStiff`] in words.
 fn kept(modes: &Option<usize>) -> String {
     match modes {
