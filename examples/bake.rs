@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use modal_mass_spring::fmi::{bake, model::Params};
+use modal_mass_spring::model::{bake, Params};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
