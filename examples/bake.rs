@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use modal_mass_spring::fmi::{bake, model::Params};
+use modal_mass_spring::model::{bake, Params};
 
 /// The two paths of the command line.
 fn parse_args() -> Result<(String, String), lexopt::Error> {

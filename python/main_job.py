@@ -15,7 +15,7 @@ import numpy as np
 from fmpy import read_model_description, simulate_fmu
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-OUTPUTS = ["positions", "modalCoordinates", "kineticEnergy", "potentialEnergy", "modeFrequencies"]
+OUTPUTS = ["positions", "modalCoordinates", "kineticEnergy", "potentialEnergy", "modeFrequencies", "springNeighbours"]
 
 
 def start_values(md):
@@ -38,25 +38,15 @@ def start_values(md):
     return out, items
 
 
-def springs(nx, ny, shear, bending):
-    """Node pairs (i, j) of the springs, node index i = row * nx + col."""
-    pairs = []
-    idx = lambda r, c: r * nx + c
-    for r in range(ny):
-        for c in range(nx):
-            if c + 1 < nx:
-                pairs.append((idx(r, c), idx(r, c + 1)))
-            if r + 1 < ny:
-                pairs.append((idx(r, c), idx(r + 1, c)))
-            if shear and r + 1 < ny and c + 1 < nx:
-                pairs.append((idx(r, c), idx(r + 1, c + 1)))
-                pairs.append((idx(r, c + 1), idx(r + 1, c)))
-            if bending:
-                if c + 2 < nx:
-                    pairs.append((idx(r, c), idx(r, c + 2)))
-                if r + 2 < ny:
-                    pairs.append((idx(r, c), idx(r + 2, c)))
-    return np.array(pairs, dtype=int).reshape(-1, 2)
+def springs(neighbours, n):
+    """Node pairs (i, j) of the springs of a sheet of n nodes, node index
+    i = row * nx + col, from the FMU's springNeighbours: per node the nodes
+    j > i it is joined to, then n (no node) in the places left."""
+    j = np.asarray(neighbours, dtype=np.int64).reshape(n, -1)
+    i = np.repeat(np.arange(n), j.shape[1])
+    j = j.ravel()
+    keep = j < n
+    return np.stack([i[keep], j[keep]], axis=1)
 
 
 def fixed_nodes(nx, ny, kind):
@@ -75,7 +65,7 @@ def plot(path, res, sv, items, title, n_frames=5):
     nx, ny = sv["nx"], sv["ny"]
     t = res["time"]
     x = res["positions"].reshape(len(t), nx * ny, -1)
-    pairs = springs(nx, ny, sv["shearSprings"], sv["bendingSprings"])
+    pairs = springs(res["springNeighbours"][0], nx * ny)
     fixed = fixed_nodes(nx, ny, items["fixedNodes"])
     frames = [int(round(k)) for k in np.linspace(0, len(t) - 1, n_frames)]
 

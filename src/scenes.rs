@@ -2,8 +2,8 @@
 //! section 5) as physics set-ups, for the study, the benchmarks and the
 //! tests: the same start values the FMU baked for a scene starts from.
 
-use crate::fmi::model::Params;
 use crate::fmi::variables::{scene_names, vr};
+use crate::model::Params;
 use crate::physics::{Grid, Loads, PhysicsError, Settings, Simulator};
 
 /// Grid, settings and loads of one set-up.

@@ -5,10 +5,10 @@
 mod common;
 
 use common::*;
-use modal_mass_spring::fmi::bake;
 use modal_mass_spring::fmi::exports::{fmi3EnterConfigurationMode, fmi3ExitConfigurationMode};
-use modal_mass_spring::fmi::model::Params;
 use modal_mass_spring::fmi::variables::vr;
+use modal_mass_spring::model::bake;
+use modal_mass_spring::model::Params;
 
 /// The start values of `scene` with modes of the load, a static correction,
 /// the given linearization and force evaluation.

@@ -12,8 +12,8 @@ mod model_description_xml;
 use std::collections::BTreeMap;
 
 use fmi_schema::fmi3::Fmi3ModelDescription;
-use modal_mass_spring::fmi::model::Params;
 use modal_mass_spring::fmi::variables::{self, vr, Causality, Type, VARIABLES};
+use modal_mass_spring::model::Params;
 use modal_mass_spring::options::{FixedNodes, Integrator};
 
 fn spec() -> generate::Spec {

@@ -302,6 +302,7 @@ fn size(f: &Fmu, r: u32) -> usize {
         vr::POSITIONS | vr::VELOCITIES => nx * ny * d,
         vr::MODAL_COORDINATES | vr::MODE_FREQUENCIES | vr::MODE_WEIGHTS => modes,
         vr::GRAVITY => 3,
+        vr::SPRING_NEIGHBOURS => nx * ny * 6,
         _ => 1,
     }
 }

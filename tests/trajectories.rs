@@ -17,8 +17,8 @@ use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use common::*;
-use modal_mass_spring::fmi::model::Params;
 use modal_mass_spring::fmi::variables::vr;
+use modal_mass_spring::model::Params;
 
 /// Canonical scene and the modes its modal cells keep: those of the
 /// stability matrix. In 3D the lowest modes are the out-of-plane cluster,

@@ -8,10 +8,13 @@ use std::collections::BTreeSet;
 use fmi_sys::fmi3::{fmi3FMUState, fmi3Status};
 
 use super::instance::Instance;
-use super::model::Params;
+use super::model::Model;
+use super::params::Params;
 use super::state_machine::Mode;
-use super::OK;
-use crate::physics::{Simulator, Snapshot};
+use super::{TheModel, OK};
+
+/// The model's part of an FMU state.
+pub type Snapshot = <TheModel as Model>::Snapshot;
 
 type R = Result<fmi3Status, fmi3Status>;
 
@@ -27,7 +30,7 @@ pub struct FmuState {
     pub stop_time: Option<f64>,
     /// Values of every parameter and input.
     pub params: Params,
-    /// State and loads of the simulator, whenever it was up to date with `params`.
+    /// The model's state, whenever it was set up for `params`.
     pub snapshot: Option<Snapshot>,
 }
 
@@ -52,20 +55,9 @@ impl Drop for OwnedStates {
     }
 }
 
-/// Every output of the simulator is a finite number.
-pub fn outputs_finite(sim: &mut Simulator) -> bool {
-    let finite = |a: &[f64]| a.iter().all(|x| x.is_finite());
-    finite(sim.positions())
-        && finite(sim.velocities())
-        && finite(sim.modal_coordinates())
-        && sim.kinetic_energy().is_finite()
-        && sim.potential_energy().is_finite()
-}
-
 impl Instance {
     pub fn capture(&self) -> FmuState {
-        let snapshot = self.sim.as_ref().filter(|_| !self.stale).map(|s| s.snapshot());
-        FmuState::new(self.mode, self.start_time, self.stop_time, self.params.clone(), snapshot)
+        FmuState::new(self.mode, self.start_time, self.stop_time, self.params.clone(), self.model.snapshot())
     }
 
     /// The state behind `state` if this instance made it and has not freed it;
@@ -123,40 +115,8 @@ impl Instance {
     /// Makes `s` the current state; on error the instance is unchanged.
     pub fn restore(&mut self, s: &FmuState) -> R {
         const F: &str = "fmi3SetFMUState";
-        let sim = match &s.snapshot {
-            Some(snap) => {
-                let reuse = self.sim.is_some() && !self.stale && self.params.same_fixed(&s.params);
-                let mut sim = if reuse {
-                    None
-                } else {
-                    match s.params.build() {
-                        Ok(sim) => Some(sim),
-                        Err(e) => return Err(self.log.fail(&format!("{F}: cannot set up the simulator: {}", super::messages::describe(&e, &s.params)))),
-                    }
-                };
-                // Restoring in place must be undoable: the state may be refused after it.
-                let prior = if reuse { self.sim.as_ref().map(|s| s.snapshot()) } else { None };
-                let target = sim.as_mut().or(self.sim.as_mut()).unwrap();
-                if let Err(e) = target.restore(snap) {
-                    return Err(self.log.fail(&format!("{F}: {}", super::messages::describe(&e, &s.params))));
-                }
-                if !outputs_finite(target) {
-                    if let Some(p) = prior {
-                        let _ = target.restore(&p);
-                    }
-                    return Err(self.log.fail(&format!("{F}: the state gives non-finite outputs (positions, velocities or energies)")));
-                }
-                sim
-            }
-            None => None,
-        };
-        if s.snapshot.is_some() {
-            if let Some(sim) = sim {
-                self.sim = Some(sim);
-            }
-            self.stale = false;
-        } else {
-            self.stale = true;
+        if let Err(m) = self.model.restore(&self.params, &s.params, s.snapshot.as_ref()) {
+            return Err(self.log.fail(&format!("{F}: {m}")));
         }
         self.params = s.params.clone();
         self.mode = s.mode;

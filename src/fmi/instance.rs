@@ -1,19 +1,21 @@
-//! One FMU instance: what it holds, its simulator built on demand from the
+//! One FMU instance: what it holds, its model set up on demand from the
 //! parameter values, and the communication step. The other jobs on an
 //! instance live in their own modules: states and transitions in
 //! [`super::state_machine`], Get/Set in [`super::values`], FMU states in
 //! [`super::fmu_state`], messages in [`super::logging`].
 
+use std::path::Path;
+
 use fmi_sys::fmi3::*;
 
 use super::fmu_state::OwnedStates;
 use super::logging::Logger;
-use super::model::Params;
+use super::model::{Model, StepEnd};
+use super::params::Params;
 use super::registry::INSTANCE_MAGIC;
 use super::state_machine::{same_time, Mode};
-use super::variables::{vr, Causality, VARIABLES};
-use super::{DISCARD, OK, WARNING};
-use crate::physics::Simulator;
+use super::variables::{Causality, VARIABLES};
+use super::{TheModel, DISCARD, OK, WARNING};
 
 type R = Result<fmi3Status, fmi3Status>;
 
@@ -25,83 +27,52 @@ pub struct Instance {
     pub poisoned: bool,
     /// Values of every parameter and input.
     pub params: Params,
+    /// The values before the Set in progress, kept in place so that a Set
+    /// that is refused restores them without allocating.
+    pub(super) before_set: Params,
     /// Values restored by fmi3Reset: compiled start values or the FMU's resources/startValues.txt.
     pub(super) start: Params,
-    /// Built lazily; `None` or `stale` means parameters changed since.
-    pub(super) sim: Option<Simulator>,
-    pub(super) stale: bool,
+    /// The model: its set-up, state and rules.
+    pub(super) model: TheModel,
     pub(super) start_time: f64,
     pub(super) stop_time: Option<f64>,
     /// FMU states made by this instance and not freed yet.
     pub(super) states: OwnedStates,
-    /// forceResidual passed forceResidualLimit once, and the host was told.
-    pub(super) residual_warned: bool,
-    /// The FMU's `resources/setup.bin`, if it has one.
-    pub(super) baked: Option<Vec<u8>>,
-    /// The host set loadColumn; until then it follows the middle of the row (nx / 2).
-    pub(super) load_column_chosen: bool,
 }
 
 impl Instance {
-    pub fn new(env: fmi3InstanceEnvironment, logger: fmi3LogMessageCallback, logging_on: bool, start: Params) -> Self {
+    pub fn new(env: fmi3InstanceEnvironment, logger: fmi3LogMessageCallback, logging_on: bool, start: Params, resources: Option<&Path>) -> Self {
         Instance {
             magic: INSTANCE_MAGIC,
             log: Logger::new(env, logger, logging_on),
             mode: Mode::Instantiated,
             poisoned: false,
             params: start.clone(),
+            before_set: start.clone(),
             start,
-            sim: None,
-            stale: true,
+            model: TheModel::new(resources),
             start_time: 0.0,
             stop_time: None,
             states: OwnedStates::default(),
-            residual_warned: false,
-            baked: None,
-            load_column_chosen: false,
         }
     }
 
-    /// Builds the simulator if parameters changed since the last build.
-    pub(super) fn ensure_sim(&mut self) -> R {
-        if self.sim.is_none() || self.stale {
-            let prebuilt = self.baked.as_ref().and_then(|bytes| match super::bake::read(bytes, &self.params) {
-                Ok(data) => Some(data),
-                Err(why) => {
-                    self.log.log(WARNING, &format!("resources/{} not used, set-up computed: {why}", super::bake::FILE));
-                    None
-                }
-            });
-            let built = match (&prebuilt, self.params.build_with(prebuilt.as_ref())) {
-                (Some(_), Ok(sim)) => {
-                    self.log.log(OK, &format!("set-up taken from resources/{}", super::bake::FILE));
-                    Ok(sim)
-                }
-                (Some(_), Err(e)) => {
-                    self.log.log(WARNING, &format!("resources/{} not used, set-up computed: {e}", super::bake::FILE));
-                    self.params.build()
-                }
-                (None, result) => result,
-            };
-            match built {
-                Ok(sim) => {
-                    self.log
-                        .log(OK, &format!("simulator set up: {} nodes in {}D, {} modes", sim.scene().n_nodes, sim.scene().dim, sim.mode_frequencies().len()));
-                    self.sim = Some(sim);
-                    self.stale = false;
-                }
-                Err(e) => return Err(self.log.fail(&format!("cannot set up the simulator: {}", super::messages::describe(&e, &self.params)))),
+    /// Sets the model up if parameters changed since the last set-up.
+    pub(super) fn ensure_set_up(&mut self) -> R {
+        if !self.model.is_set_up() {
+            if let Err(m) = self.model.set_up(&self.params, &self.log) {
+                return Err(self.log.fail(&m));
             }
         }
         Ok(OK)
     }
 
-    /// The FMU's time: the start time plus the simulator's.
+    /// The FMU's time: the start time plus the model's.
     pub fn time(&self) -> f64 {
-        self.start_time + self.sim.as_ref().filter(|_| !self.stale).map_or(0.0, |s| s.time())
+        self.start_time + self.model.time().unwrap_or(0.0)
     }
 
-    /// fmi3DoStep: one communication step; a step the simulator refuses is
+    /// fmi3DoStep: one communication step; a step the model refuses is
     /// discarded with the state kept at its start.
     ///
     /// # Safety
@@ -139,30 +110,18 @@ impl Instance {
                 return Err(self.log.fail(&format!("{F}: the step would end at {end}, past stopTime {stop}")));
             }
         }
-        let sim = self.sim.as_mut().expect("Step Mode has a simulator");
-        match sim.do_step(h) {
-            Ok(()) => {
-                let end = self.start_time + sim.time();
-                unsafe { *last_successful_time = end };
-                // The check costs one pass over every spring; a limit of 0 turns it off.
-                let limit = self.params.scalar(vr::FORCE_RESIDUAL_LIMIT);
-                let residual = if self.residual_warned || limit <= 0.0 { 0.0 } else { sim.force_residual() };
-                if residual > limit {
-                    self.residual_warned = true;
-                    self.log.log(
-                        WARNING,
-                        &format!(
-                            "{F}: at t = {end} forceResidual = {residual:.3} passed forceResidualLimit = {limit}: the modal basis holds \
-                             too little of the force at this state; the results may leave the full-space model (more modes, \
-                             modeSelection = load, or reduction = full)"
-                        ),
-                    );
-                    return Ok(WARNING);
+        match self.model.do_step(&self.params, h, self.start_time) {
+            Ok(end) => {
+                unsafe { *last_successful_time = self.time() };
+                match end {
+                    StepEnd::Done => Ok(OK),
+                    StepEnd::Warning(m) => {
+                        self.log.log(WARNING, &format!("{F}: {m}"));
+                        Ok(WARNING)
+                    }
                 }
-                Ok(OK)
             }
-            Err(e) => {
-                let why = super::messages::describe(&e, &self.params);
+            Err(why) => {
                 self.log.log(DISCARD, &format!("{F}: step from t = {now} by {h} s refused, state kept at t = {now}: {why}"));
                 Err(DISCARD)
             }

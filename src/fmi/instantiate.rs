@@ -10,7 +10,7 @@ use fmi_sys::fmi3::*;
 use super::functions::Function;
 use super::instance::Instance;
 use super::logging::log_raw;
-use super::model::Params;
+use super::params::Params;
 use super::variables::INSTANTIATION_TOKEN;
 use super::{registry, ERROR, FATAL, OK};
 
@@ -57,25 +57,25 @@ pub unsafe fn co_simulation(
         if name.trim().is_empty() {
             return fail("instanceName is empty".into());
         }
-        let mut baked = None;
-        let start = if resource_path.is_null() {
-            Params::start()
-        } else {
+        let dir = (!resource_path.is_null()).then(|| {
             let dir = unsafe { CStr::from_ptr(resource_path) }.to_string_lossy().into_owned();
-            let dir = dir.strip_prefix("file://").unwrap_or(&dir).to_string();
-            baked = std::fs::read(std::path::Path::new(&dir).join(super::bake::FILE)).ok();
-            let file = std::path::Path::new(&dir).join("startValues.txt");
-            match std::fs::read_to_string(&file) {
-                Ok(text) => match Params::from_text(&text) {
-                    Ok(p) => p,
-                    Err(m) => return fail(format!("{}: {m}", file.display())),
-                },
-                // No file: the compiled start values are those of modelDescription.xml.
-                Err(_) => Params::start(),
+            std::path::PathBuf::from(dir.strip_prefix("file://").unwrap_or(&dir))
+        });
+        let start = match &dir {
+            None => Params::start(),
+            Some(dir) => {
+                let file = dir.join("startValues.txt");
+                match std::fs::read_to_string(&file) {
+                    Ok(text) => match Params::from_text(&text) {
+                        Ok(p) => p,
+                        Err(m) => return fail(format!("{}: {m}", file.display())),
+                    },
+                    // No file: the compiled start values are those of modelDescription.xml.
+                    Err(_) => Params::start(),
+                }
             }
         };
-        let mut inst = Instance::new(env, logger, logging_on, start);
-        inst.baked = baked;
+        let inst = Instance::new(env, logger, logging_on, start, dir.as_deref());
         inst.log.log(OK, &format!("instance \"{name}\" created"));
         registry::register(inst)
     });

@@ -1,4 +1,5 @@
-//! FMI 3.0 Co-Simulation layer over [`crate::physics`], split by job:
+//! FMI 3.0 Co-Simulation layer, generic over the model it exports
+//! ([`model::Model`], bound to [`crate::model`] by [`TheModel`]), split by job:
 //!
 //! - [`functions`]: the table of every `fmi3*` function and the states it is legal in;
 //! - [`exports`]: the C functions, one short entry each, through one guard;
@@ -9,20 +10,21 @@
 //! - [`values`]: Get/Set marshalling, range and causality checks;
 //! - [`fmu_state`] and [`serialize`]: FMU states and their byte format;
 //! - [`logging`]: the host's log callback and categories;
-//! - [`model`]: variable values -> physics, physics -> outputs;
-//! - [`bake`]: the baked set-up in `resources/setup.bin`;
-//! - [`messages`]: physics errors as messages naming variables;
+//! - [`params`]: the values of the parameters and inputs, stored against the table;
+//! - [`model`]: the interface a model implements for the glue;
 //! - [`variables`]: the variable table generated from `modelDescription/variables.toml`.
+//!
+//! No variable of the model is named here outside the generated table, and
+//! none of its rules lives here (`tests/glue_is_generic.rs` checks the names).
 
-pub mod bake;
 pub mod exports;
 pub mod fmu_state;
 pub mod functions;
 pub mod instance;
 pub mod instantiate;
 pub mod logging;
-pub mod messages;
 pub mod model;
+pub mod params;
 pub mod ptr;
 pub mod registry;
 pub mod serialize;
@@ -31,6 +33,10 @@ pub mod values;
 pub mod variables;
 
 use fmi_sys::fmi3::*;
+
+/// The model this FMU exports: the one place the glue is bound to it (the
+/// Reference FMUs' `config.h`).
+pub type TheModel = crate::model::MassSpring;
 
 pub const OK: fmi3Status = fmi3Status_fmi3OK;
 pub const WARNING: fmi3Status = fmi3Status_fmi3Warning;

@@ -6,7 +6,7 @@
 //! | 4 | format version |
 //! | 8 | fingerprint of the variable layout |
 //! | 8 | payload length |
-//! | n | payload: mode, start time, stop time, every parameter and input (vr, length, values), simulator snapshot (time, y, y', y'', anchor and its rate, loads: gravity, point load, load node, anchor target, damping, weights) |
+//! | n | payload: mode, start time, stop time, every parameter and input (vr, length, values), the model's snapshot ([`Model::write_snapshot`], documented with the model) |
 //! | 4 | CRC-32 (IEEE) of everything before |
 //!
 //! Decoding checks all of it and every value against the model description,
@@ -16,13 +16,13 @@ use fmi_sys::fmi3::{fmi3FMUState, fmi3Status};
 
 use super::fmu_state::FmuState;
 use super::instance::Instance;
-use super::model::Params;
+use super::model::Model;
+use super::params::Params;
 use super::ptr::{slice, too_many};
 use super::state_machine::Mode;
 use super::values::check_value;
 use super::variables::{index_of, LAYOUT_FINGERPRINT, VARIABLES};
-use super::OK;
-use crate::physics::{Loads, Snapshot, State};
+use super::{TheModel, OK};
 
 type R = Result<fmi3Status, fmi3Status>;
 
@@ -80,20 +80,7 @@ pub fn payload(s: &FmuState) -> Vec<u8> {
         None => p.push(0),
         Some(snap) => {
             p.push(1);
-            let s = &snap.state;
-            put_f64(&mut p, s.time);
-            put_f64s(&mut p, &s.y);
-            put_f64s(&mut p, &s.v);
-            put_f64s(&mut p, &s.a);
-            s.anchor.iter().chain(&s.anchor_rate).for_each(|x| put_f64(&mut p, *x));
-            let l = &snap.loads;
-            l.gravity.iter().for_each(|g| put_f64(&mut p, *g));
-            l.point_load.iter().for_each(|f| put_f64(&mut p, *f));
-            put_u64(&mut p, l.load_node.map_or(u64::MAX, |n| n as u64));
-            l.anchor.iter().for_each(|a| put_f64(&mut p, *a));
-            put_f64(&mut p, l.damping_alpha);
-            put_f64(&mut p, l.damping_beta);
-            put_f64s(&mut p, &l.mode_weights);
+            TheModel::write_snapshot(snap, &mut p);
         }
     }
     p
@@ -178,31 +165,7 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
     }
     let snapshot = match r.u8()? {
         0 => None,
-        1 => {
-            let (time, y, v, a) = (r.f64()?, r.f64s()?, r.f64s()?, r.f64s()?);
-            let (anchor, anchor_rate) = ([r.f64()?, r.f64()?, r.f64()?], [r.f64()?, r.f64()?, r.f64()?]);
-            let state = State { time, y, v, a, anchor, anchor_rate };
-            let gravity = [r.f64()?, r.f64()?, r.f64()?];
-            let point_load = [r.f64()?, r.f64()?, r.f64()?];
-            let load_node = match r.u64()? {
-                u64::MAX => None,
-                n => Some(usize::try_from(n).map_err(|_| "load node out of range".to_string())?),
-            };
-            let anchor = [r.f64()?, r.f64()?, r.f64()?];
-            if !anchor.iter().all(|a| a.is_finite()) {
-                return Err("the anchor target holds non-finite values".into());
-            }
-            let damping_alpha = r.f64()?;
-            let damping_beta = r.f64()?;
-            let mode_weights = r.f64s()?;
-            if !(state.is_finite() && state.time >= 0.0) {
-                return Err("the simulator state holds a negative or non-finite time or non-finite values".into());
-            }
-            if state.v.len() != state.y.len() || state.a.len() != state.y.len() {
-                return Err(format!("the simulator state holds arrays of {}, {} and {} values", state.y.len(), state.v.len(), state.a.len()));
-            }
-            Some(Snapshot { state, loads: Loads { gravity, point_load, load_node, anchor, damping_alpha, damping_beta, mode_weights } })
-        }
+        1 => Some(TheModel::read_snapshot(&mut r)?),
         _ => return Err("bad snapshot flag".into()),
     };
     if !r.b.is_empty() {
@@ -212,9 +175,7 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
         return Err("a state after initialization must hold the simulator state".into());
     }
     if let Some(s) = &snapshot {
-        if s.loads != params.loads() {
-            return Err("the simulator's loads differ from the parameters".into());
-        }
+        TheModel::check_snapshot(s, &params)?;
     }
     if matches!(mode, Mode::Instantiated | Mode::ConfigurationMode) && stop_time.is_some() {
         return Err("a state before initialization has no stop time".into());
@@ -222,18 +183,19 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
     Ok(FmuState::new(mode, start_time, stop_time, params, snapshot))
 }
 
-fn put_u64(v: &mut Vec<u8>, x: u64) {
+pub fn put_u64(v: &mut Vec<u8>, x: u64) {
     v.extend_from_slice(&x.to_le_bytes());
 }
-fn put_f64(v: &mut Vec<u8>, x: f64) {
+pub fn put_f64(v: &mut Vec<u8>, x: f64) {
     v.extend_from_slice(&x.to_le_bytes());
 }
-fn put_f64s(v: &mut Vec<u8>, x: &[f64]) {
+pub fn put_f64s(v: &mut Vec<u8>, x: &[f64]) {
     put_u64(v, x.len() as u64);
     x.iter().for_each(|x| put_f64(v, *x));
 }
 
-struct Reader<'a> {
+/// Reads a payload front to back; every read checks the bytes left.
+pub struct Reader<'a> {
     b: &'a [u8],
 }
 
@@ -246,20 +208,20 @@ impl Reader<'_> {
         self.b = rest;
         Ok(a)
     }
-    fn u8(&mut self) -> Result<u8, String> {
+    pub fn u8(&mut self) -> Result<u8, String> {
         Ok(self.take(1)?[0])
     }
-    fn u32(&mut self) -> Result<u32, String> {
+    pub fn u32(&mut self) -> Result<u32, String> {
         Ok(u32::from_le_bytes(self.take(4)?.try_into().unwrap()))
     }
-    fn u64(&mut self) -> Result<u64, String> {
+    pub fn u64(&mut self) -> Result<u64, String> {
         Ok(u64::from_le_bytes(self.take(8)?.try_into().unwrap()))
     }
-    fn f64(&mut self) -> Result<f64, String> {
+    pub fn f64(&mut self) -> Result<f64, String> {
         Ok(f64::from_le_bytes(self.take(8)?.try_into().unwrap()))
     }
     /// Length-prefixed; the length is checked against the bytes left before allocating.
-    fn f64s(&mut self) -> Result<Vec<f64>, String> {
+    pub fn f64s(&mut self) -> Result<Vec<f64>, String> {
         let n = self.u64()?;
         if n > (self.b.len() / 8) as u64 {
             return Err("truncated serialized state".into());

@@ -5,6 +5,7 @@
 
 use super::functions::Function;
 use super::instance::Instance;
+use super::model::Model;
 use super::OK;
 
 /// States an instance can be in.
@@ -86,7 +87,7 @@ impl Instance {
     }
 
     pub fn exit_initialization_mode(&mut self) -> R {
-        self.ensure_sim()?;
+        self.ensure_set_up()?;
         self.mode = Mode::StepMode;
         self.log.log(OK, "Step Mode");
         Ok(OK)
@@ -111,12 +112,9 @@ impl Instance {
     pub fn reset(&mut self) -> R {
         self.mode = Mode::Instantiated;
         self.params = self.start.clone();
-        self.sim = None;
-        self.stale = true;
+        self.model.reset();
         self.start_time = 0.0;
         self.stop_time = None;
-        self.residual_warned = false;
-        self.load_column_chosen = false;
         Ok(OK)
     }
 }

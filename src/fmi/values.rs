@@ -6,10 +6,10 @@ use fmi_sys::fmi3::fmi3Status;
 
 use super::functions::Function;
 use super::instance::Instance;
-use super::model::{computed, Computed};
+use super::model::{Computed, Model};
 use super::ptr::{slice, slice_mut, too_many};
 use super::state_machine::Mode;
-use super::variables::{index_of, vr, Causality, Type, Variability, Variable, VARIABLES};
+use super::variables::{index_of, Causality, Type, Variability, Variable, VARIABLES};
 use super::OK;
 
 type R = Result<fmi3Status, fmi3Status>;
@@ -105,7 +105,7 @@ impl Instance {
             !v.holds_value() && v.causality != Causality::Independent
         });
         if needs_sim {
-            self.ensure_sim()?;
+            self.ensure_set_up()?;
         }
         let out = slice_mut(values, n_values);
         let mut k = 0;
@@ -120,7 +120,7 @@ impl Instance {
             } else if v.causality == Causality::Independent {
                 out[k] = conv(self.time());
             } else {
-                match computed(self.sim.as_mut().unwrap(), r, self.start_time) {
+                match self.model.output(r, self.start_time) {
                     Computed::Scalar(x) => out[k] = conv(x),
                     Computed::Array(a) => {
                         if a.len() != n {
@@ -148,9 +148,10 @@ impl Instance {
     }
 
     /// fmi3Set of variables of type `ty`, converted by `conv` (`None`: not
-    /// representable). Either every value is stored or none; a change of a
-    /// tunable parameter or an input in Step Mode reaches the simulator at
-    /// once, and is undone if the simulator refuses it.
+    /// representable). Either every value is stored or none: the glue checks
+    /// and stores, then the model applies its own rules ([`Model::set`]); a
+    /// change of a tunable parameter or an input in Step Mode reaches the
+    /// running model at once, and is undone if the model refuses it.
     ///
     /// # Safety
     /// As for [`Instance::get`].
@@ -184,13 +185,14 @@ impl Instance {
             }
             k += n;
         }
-        let old = self.params.clone();
+        // The values before, in a copy kept in place: allocates nothing unless the sizes changed.
+        self.before_set.values.clone_from(&self.params.values);
         let mut k = 0;
         let mut structure = false;
         for &r in vrs {
             let i = index_of(r).unwrap();
             let v = &VARIABLES[i];
-            let n = old.size_of(v);
+            let n = self.before_set.size_of(v);
             for (dst, &raw) in self.params.values[i].iter_mut().zip(&values[k..k + n]) {
                 *dst = conv(raw).unwrap();
             }
@@ -200,33 +202,9 @@ impl Instance {
         if structure {
             self.params.fit_arrays();
         }
-        // The load node's column follows the middle of the bottom row until the host chooses it.
-        let chooses_column = vrs.contains(&vr::LOAD_COLUMN);
-        if !chooses_column && !self.load_column_chosen && vrs.contains(&vr::NX) {
-            let middle = (self.params.scalar(vr::NX) / 2.0).floor();
-            self.params.set(vr::LOAD_COLUMN, &[middle]);
-        }
-        if self.params == old {
-            self.load_column_chosen |= chooses_column;
-            return Ok(OK);
-        }
-        // The load node is checked against the grid when it is chosen.
-        if vrs.iter().any(|&r| r == vr::LOAD_ROW || r == vr::LOAD_COLUMN) {
-            if let Some(why) = self.params.load_node_problem() {
-                self.params = old;
-                return Err(self.log.fail(&format!("{}: refused: {why}", f.name())));
-            }
-        }
-        self.load_column_chosen |= chooses_column;
-        if self.mode == Mode::StepMode {
-            // Only tunables and inputs get here; they act from the next step on.
-            let loads = self.params.loads();
-            if let Err(e) = self.sim.as_mut().unwrap().set_loads(&loads) {
-                self.params = old;
-                return Err(self.log.fail(&format!("{}: {}", f.name(), super::messages::describe(&e, &self.params))));
-            }
-        } else {
-            self.stale = true;
+        if let Err(m) = self.model.set(&mut self.params, &self.before_set, vrs, self.mode == Mode::StepMode) {
+            std::mem::swap(&mut self.params, &mut self.before_set);
+            return Err(self.log.fail(&format!("{}: {m}", f.name())));
         }
         Ok(OK)
     }

@@ -2,7 +2,7 @@
 //!
 //! Each error says which quantity is at fault, which limit it passed and,
 //! where there is one, what would lift it, in the terms of the physics
-//! (`docs/method.md`). The FMI layer (`crate::fmi::messages`) turns them
+//! (`docs/method.md`). The FMI layer (`crate::model::messages`) turns them
 //! into messages that name its variables; [`std::fmt::Display`] (thiserror) here is for
 //! users of the core alone (tests, benchmarks, the study).
 

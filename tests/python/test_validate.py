@@ -62,6 +62,7 @@ INTERFACE = {
     "anchorForceZ": ("Float64", "output", "continuous"),
     "cubatureSprings": ("UInt64", "calculatedParameter", "fixed"),
     "modeFrequencies": ("Float64", "calculatedParameter", "fixed"),
+    "springNeighbours": ("UInt64", "calculatedParameter", "fixed"),
 }
 
 ENUMERATIONS = {
@@ -80,6 +81,7 @@ DIMENSIONS = {
     "velocities": ["ny", "nx", "dimension"],
     "modalCoordinates": ["nModes"],
     "modeFrequencies": ["nModes"],
+    "springNeighbours": ["ny", "nx", 6],
 }
 
 

@@ -1,8 +1,8 @@
 //! Physics errors as messages that name the FMU's variables: the one place
 //! where the quantities of the core meet the names of the model description.
 
-use super::model::Params;
-use super::variables::vr;
+use crate::fmi::params::Params;
+use crate::fmi::variables::vr;
 use crate::options::{Integrator, Reduction};
 use crate::physics::{PhysicsError, Quantity, StepFailure};
 

@@ -14,8 +14,8 @@
 //! count, f64 bits), the data (u64 length + [`SetupData::to_bytes`]), and a
 //! CRC-32 of everything before it.
 
-use super::model::Params;
-use super::variables::{vr, Variability, VARIABLES};
+use crate::fmi::params::Params;
+use crate::fmi::variables::{vr, Variability, VARIABLES};
 use crate::physics::{SetupData, Simulator};
 
 /// File name under `resources/`.

@@ -1,0 +1,294 @@
+//! The model this FMU exports, beside the generic FMI layer [`crate::fmi`]
+//! (as the Modelica Reference FMUs keep each model's `model.c` beside their
+//! generic `fmi3Functions.c`): what the variables of
+//! `modelDescription/variables.toml` mean to [`crate::physics`], and the
+//! model's own rules, behind the [`Model`] interface the glue calls.
+//!
+//! - [`params`]: values -> grid, solver settings, loads, load node; the canonical scenes;
+//! - [`messages`]: physics errors as messages naming the variables;
+//! - [`bake`]: the baked set-up in `resources/setup.bin`;
+//! - [`snapshot`]: the simulator's part of a serialized FMU state;
+//! - here: set-up, the Set rules (the load node's default column, its
+//!   check, loads passed to the running simulator), the outputs, the step
+//!   and when it warns about forceResidual.
+
+pub mod bake;
+pub mod messages;
+pub mod params;
+mod snapshot;
+
+use std::path::Path;
+
+use crate::fmi::logging::Logger;
+use crate::fmi::model::{Computed, Model, StepEnd};
+use crate::fmi::serialize::Reader;
+use crate::fmi::variables::vr;
+use crate::fmi::{OK, WARNING};
+use crate::physics::{Loads, Simulator, Snapshot};
+
+pub use crate::fmi::params::Params;
+
+/// The mass-spring sheet of the model description, as one instance runs it.
+pub struct MassSpring {
+    /// Built on demand; `None` or `stale` means the values changed since.
+    sim: Option<Simulator>,
+    stale: bool,
+    /// The FMU's `resources/setup.bin`, if it has one.
+    baked: Option<Vec<u8>>,
+    /// forceResidual passed forceResidualLimit once, and the host was told.
+    residual_warned: bool,
+    /// The host set loadColumn; until then it follows the middle of the row (nx / 2).
+    load_column_chosen: bool,
+    /// Scratch for the loads handed to the simulator, filled in place and
+    /// sized at set-up: a change in Step Mode allocates nothing.
+    loads: Loads,
+    /// The springs between nodes (see [`MassSpring::spring_neighbours`]), made when first read.
+    springs: Option<Vec<f64>>,
+}
+
+impl Model for MassSpring {
+    type Snapshot = Snapshot;
+
+    fn new(resources: Option<&Path>) -> Self {
+        MassSpring {
+            sim: None,
+            stale: true,
+            baked: resources.and_then(|dir| std::fs::read(dir.join(bake::FILE)).ok()),
+            residual_warned: false,
+            load_column_chosen: false,
+            loads: Params::start().loads(),
+            springs: None,
+        }
+    }
+
+    fn reset(&mut self) {
+        self.sim = None;
+        self.stale = true;
+        self.residual_warned = false;
+        self.load_column_chosen = false;
+        self.springs = None;
+    }
+
+    fn is_set_up(&self) -> bool {
+        self.sim.is_some() && !self.stale
+    }
+
+    fn set_up(&mut self, p: &Params, log: &Logger) -> Result<(), String> {
+        let prebuilt = self.baked.as_ref().and_then(|bytes| match bake::read(bytes, p) {
+            Ok(data) => Some(data),
+            Err(why) => {
+                log.log(WARNING, &format!("resources/{} not used, set-up computed: {why}", bake::FILE));
+                None
+            }
+        });
+        let built = match (&prebuilt, p.build_with(prebuilt.as_ref())) {
+            (Some(_), Ok(sim)) => {
+                log.log(OK, &format!("set-up taken from resources/{}", bake::FILE));
+                Ok(sim)
+            }
+            (Some(_), Err(e)) => {
+                log.log(WARNING, &format!("resources/{} not used, set-up computed: {e}", bake::FILE));
+                p.build()
+            }
+            (None, result) => result,
+        };
+        match built {
+            Ok(sim) => {
+                log.log(OK, &format!("simulator set up: {} nodes in {}D, {} modes", sim.scene().n_nodes, sim.scene().dim, sim.mode_frequencies().len()));
+                self.installed(sim, p);
+                Ok(())
+            }
+            Err(e) => Err(format!("cannot set up the simulator: {}", messages::describe(&e, p))),
+        }
+    }
+
+    fn time(&self) -> Option<f64> {
+        self.sim.as_ref().filter(|_| !self.stale).map(|s| s.time())
+    }
+
+    fn set(&mut self, p: &mut Params, old: &Params, vrs: &[u32], running: bool) -> Result<(), String> {
+        let chooses_column = vrs.contains(&vr::LOAD_COLUMN);
+        if !chooses_column && !self.load_column_chosen && vrs.contains(&vr::NX) {
+            p.follow_middle_column();
+        }
+        if p == old {
+            self.load_column_chosen |= chooses_column;
+            return Ok(());
+        }
+        // The load node is checked against the grid when it is chosen.
+        if vrs.iter().any(|&r| r == vr::LOAD_ROW || r == vr::LOAD_COLUMN) {
+            if let Some(why) = p.load_node_problem() {
+                return Err(format!("refused: {why}"));
+            }
+        }
+        self.load_column_chosen |= chooses_column;
+        if running {
+            // Only tunables and inputs get here; they act from the next step on.
+            p.fill_loads(&mut self.loads);
+            let sim = self.sim.as_mut().expect("Step Mode has a simulator");
+            sim.set_loads(&self.loads).map_err(|e| messages::describe(&e, p))?;
+        } else {
+            self.stale = true;
+        }
+        Ok(())
+    }
+
+    fn output(&mut self, r: u32, time0: f64) -> Computed<'_> {
+        if r == vr::SPRING_NEIGHBOURS {
+            return Computed::Array(self.spring_neighbours());
+        }
+        let sim = self.sim.as_mut().expect("outputs are read from a simulator");
+        match r {
+            vr::TIME => Computed::Scalar(time0 + sim.time()),
+            vr::POSITIONS => Computed::Array(sim.positions()),
+            vr::VELOCITIES => Computed::Array(sim.velocities()),
+            vr::MODAL_COORDINATES => Computed::Array(sim.modal_coordinates()),
+            vr::KINETIC_ENERGY => Computed::Scalar(sim.kinetic_energy()),
+            vr::POTENTIAL_ENERGY => Computed::Scalar(sim.potential_energy()),
+            vr::MODE_FREQUENCIES => Computed::Array(sim.mode_frequencies()),
+            vr::FORCE_RESIDUAL => Computed::Scalar(sim.force_residual()),
+            vr::CUBATURE_SPRINGS => Computed::Scalar(sim.cubature_springs() as f64),
+            vr::LOAD_NODE_X | vr::LOAD_NODE_Y | vr::LOAD_NODE_Z => Computed::Scalar(component(sim.load_node_position(), (r - vr::LOAD_NODE_X) as usize)),
+            vr::LOAD_NODE_V_X | vr::LOAD_NODE_V_Y | vr::LOAD_NODE_V_Z => {
+                Computed::Scalar(component(sim.load_node_velocity(), (r - vr::LOAD_NODE_V_X) as usize))
+            }
+            vr::ANCHOR_FORCE_X | vr::ANCHOR_FORCE_Y | vr::ANCHOR_FORCE_Z => Computed::Scalar(sim.anchor_force()[(r - vr::ANCHOR_FORCE_X) as usize]),
+            _ => unreachable!("value reference {r} is not computed"),
+        }
+    }
+
+    fn do_step(&mut self, p: &Params, h: f64, time0: f64) -> Result<StepEnd, String> {
+        let sim = self.sim.as_mut().expect("Step Mode has a simulator");
+        if let Err(e) = sim.do_step(h) {
+            return Err(messages::describe(&e, p));
+        }
+        // The check costs one pass over every spring; a limit of 0 turns it off.
+        let limit = p.scalar(vr::FORCE_RESIDUAL_LIMIT);
+        let residual = if self.residual_warned || limit <= 0.0 { 0.0 } else { sim.force_residual() };
+        if residual > limit {
+            self.residual_warned = true;
+            let end = time0 + sim.time();
+            return Ok(StepEnd::Warning(format!(
+                "at t = {end} forceResidual = {residual:.3} passed forceResidualLimit = {limit}: the modal basis holds \
+                 too little of the force at this state; the results may leave the full-space model (more modes, \
+                 modeSelection = load, or reduction = full)"
+            )));
+        }
+        Ok(StepEnd::Done)
+    }
+
+    fn snapshot(&self) -> Option<Snapshot> {
+        self.sim.as_ref().filter(|_| !self.stale).map(|s| s.snapshot())
+    }
+
+    fn restore(&mut self, current: &Params, p: &Params, snap: Option<&Snapshot>) -> Result<(), String> {
+        let Some(snap) = snap else {
+            self.stale = true;
+            return Ok(());
+        };
+        let reuse = self.is_set_up() && current.same_fixed(p);
+        let mut sim = if reuse {
+            None
+        } else {
+            match p.build() {
+                Ok(sim) => Some(sim),
+                Err(e) => return Err(format!("cannot set up the simulator: {}", messages::describe(&e, p))),
+            }
+        };
+        // Restoring in place must be undoable: the state may be refused after it.
+        let prior = if reuse { self.sim.as_ref().map(|s| s.snapshot()) } else { None };
+        let target = sim.as_mut().or(self.sim.as_mut()).unwrap();
+        if let Err(e) = target.restore(snap) {
+            return Err(messages::describe(&e, p));
+        }
+        if !outputs_finite(target) {
+            if let Some(prior) = prior {
+                let _ = target.restore(&prior);
+            }
+            return Err("the state gives non-finite outputs (positions, velocities or energies)".into());
+        }
+        if let Some(sim) = sim {
+            self.installed(sim, p);
+        }
+        self.stale = false;
+        Ok(())
+    }
+
+    fn write_snapshot(s: &Snapshot, out: &mut Vec<u8>) {
+        snapshot::write(s, out)
+    }
+
+    fn read_snapshot(r: &mut Reader) -> Result<Snapshot, String> {
+        snapshot::read(r)
+    }
+
+    fn check_snapshot(s: &Snapshot, p: &Params) -> Result<(), String> {
+        if s.loads != p.loads() {
+            return Err("the simulator's loads differ from the parameters".into());
+        }
+        Ok(())
+    }
+}
+
+impl MassSpring {
+    /// Makes `sim`, set up from `p`, the current simulator (and sizes the
+    /// loads' scratch for it).
+    fn installed(&mut self, sim: Simulator, p: &Params) {
+        p.fill_loads(&mut self.loads);
+        self.sim = Some(sim);
+        self.stale = false;
+        self.springs = None;
+    }
+
+    /// The springs between two nodes of the scene (auxiliary springs, tied
+    /// to a point off the sheet, left out): for every node i in output
+    /// order, the nodes j > i a spring joins it to, ascending, then n (no
+    /// node) up to [`MAX_SPRINGS_PER_NODE`] places.
+    fn spring_neighbours(&mut self) -> &[f64] {
+        let sim = self.sim.as_ref().expect("outputs are read from a simulator");
+        self.springs.get_or_insert_with(|| {
+            let scene = sim.scene();
+            let n = scene.n_nodes;
+            let mut node_of_slot = vec![usize::MAX; scene.rest.len() / scene.dim];
+            for (node, &slot) in scene.slot_of_node.iter().enumerate() {
+                node_of_slot[slot] = node;
+            }
+            let mut ends: Vec<Vec<usize>> = vec![Vec::new(); n];
+            for s in &scene.springs {
+                let (a, b) = (node_of_slot[s.a], node_of_slot[s.b]);
+                if a != usize::MAX && b != usize::MAX {
+                    ends[a.min(b)].push(a.max(b));
+                }
+            }
+            let mut out = vec![n as f64; n * MAX_SPRINGS_PER_NODE];
+            for (i, mut js) in ends.into_iter().enumerate() {
+                js.sort_unstable();
+                // The grid starts at most MAX_SPRINGS_PER_NODE springs at a node.
+                for (o, j) in out[i * MAX_SPRINGS_PER_NODE..(i + 1) * MAX_SPRINGS_PER_NODE].iter_mut().zip(js) {
+                    *o = j as f64;
+                }
+            }
+            out
+        })
+    }
+}
+
+/// Springs the grid starts at one node, to the nodes of higher index: the
+/// next in its row, the one below, two diagonals, two bending springs.
+pub const MAX_SPRINGS_PER_NODE: usize = 6;
+
+/// Component `i` of a node vector (z is 0 in 2D); NaN when there is no
+/// such node (set-up refuses a load node outside the grid).
+fn component(v: Option<[f64; 3]>, i: usize) -> f64 {
+    v.map_or(f64::NAN, |v| v[i])
+}
+
+/// Every output of the simulator is a finite number.
+pub fn outputs_finite(sim: &mut Simulator) -> bool {
+    let finite = |a: &[f64]| a.iter().all(|x| x.is_finite());
+    finite(sim.positions())
+        && finite(sim.velocities())
+        && finite(sim.modal_coordinates())
+        && sim.kinetic_energy().is_finite()
+        && sim.potential_energy().is_finite()
+}

@@ -1,0 +1,133 @@
+//! What the values of the variables mean to the physics: the grid, the
+//! solver settings, the loads and the load node, and the canonical scenes'
+//! start values.
+
+use crate::fmi::params::Params;
+use crate::fmi::variables::{index_of, vr, SCENES};
+use crate::options::{FixedNodes, ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction};
+use crate::physics::{Grid, Loads, PhysicsError, Settings, SetupData, Simulator};
+
+impl Params {
+    /// The start values of the canonical scene `name` (the `[scenes.NAME]`
+    /// tables of `modelDescription/variables.toml`).
+    pub fn canonical(name: &str) -> Option<Self> {
+        let scene = SCENES.iter().find(|s| s.name == name)?;
+        let mut p = Params::start();
+        for (vr, values) in scene.values {
+            p.values[index_of(*vr).expect("scene variables exist")] = values.to_vec();
+        }
+        p.fit_arrays();
+        Some(p)
+    }
+
+    fn enumeration<T>(&self, vr: u32, from_value: fn(i64) -> Option<T>) -> T {
+        from_value(self.scalar(vr) as i64).expect("enumeration values are range-checked")
+    }
+
+    /// The grid of `nx` x `ny` nodes these values describe.
+    pub fn grid(&self) -> Grid {
+        Grid {
+            columns: self.count(vr::NX),
+            rows: self.count(vr::NY),
+            dim: self.count(vr::DIMENSION),
+            spacing: self.scalar(vr::SPACING),
+            node_mass: self.scalar(vr::NODE_MASS),
+            spring_stiffness: self.scalar(vr::SPRING_STIFFNESS),
+            shear_springs: self.scalar(vr::SHEAR_SPRINGS) != 0.0,
+            bending_springs: self.scalar(vr::BENDING_SPRINGS) != 0.0,
+            aux_stiffness: self.scalar(vr::AUX_STIFFNESS),
+            fixed_nodes: self.enumeration(vr::FIXED_NODES, FixedNodes::from_value),
+        }
+    }
+
+    /// The solver settings: the one place the model builds them.
+    pub fn settings(&self) -> Settings {
+        Settings {
+            reduction: self.enumeration(vr::REDUCTION, Reduction::from_value),
+            integrator: self.enumeration(vr::INTEGRATOR, Integrator::from_value),
+            n_modes: self.count(vr::N_MODES),
+            mode_selection: self.enumeration(vr::MODE_SELECTION, ModeSelection::from_value),
+            static_correction: self.scalar(vr::STATIC_CORRECTION) != 0.0,
+            linearization: self.enumeration(vr::LINEARIZATION, Linearization::from_value),
+            anchor_motion: self.scalar(vr::ANCHOR_MOTION) != 0.0,
+            force_evaluation: self.enumeration(vr::FORCE_EVALUATION, ForceEvaluation::from_value),
+            cubature_tolerance: self.scalar(vr::CUBATURE_TOLERANCE),
+            max_internal_step: self.scalar(vr::MAX_INTERNAL_STEP),
+            substepping: true,
+        }
+    }
+
+    pub fn loads(&self) -> Loads {
+        let mut loads = Loads {
+            gravity: [0.0; 3],
+            point_load: [0.0; 3],
+            load_node: None,
+            anchor: [0.0; 3],
+            damping_alpha: 0.0,
+            damping_beta: 0.0,
+            mode_weights: Vec::new(),
+        };
+        self.fill_loads(&mut loads);
+        loads
+    }
+
+    /// Writes the loads these values describe into `loads`, reusing its
+    /// weights' buffer (a change in Step Mode allocates nothing).
+    pub fn fill_loads(&self, loads: &mut Loads) {
+        let g = self.get(vr::GRAVITY);
+        loads.gravity = [g[0], g[1], g[2]];
+        loads.point_load = [self.scalar(vr::LOAD_X), self.scalar(vr::LOAD_Y), self.scalar(vr::LOAD_Z)];
+        loads.load_node = self.load_node();
+        loads.anchor = [self.scalar(vr::ANCHOR_X), self.scalar(vr::ANCHOR_Y), self.scalar(vr::ANCHOR_Z)];
+        loads.damping_alpha = self.scalar(vr::DAMPING_ALPHA);
+        loads.damping_beta = self.scalar(vr::DAMPING_BETA);
+        loads.mode_weights.clear();
+        loads.mode_weights.extend_from_slice(self.get(vr::MODE_WEIGHTS));
+    }
+
+    /// The load node (loadRow counted from the bottom edge, loadColumn
+    /// from x = 0) as a node index in output order, if it is in the grid.
+    pub fn load_node(&self) -> Option<usize> {
+        let grid = self.grid();
+        let (row, col) = (self.count(vr::LOAD_ROW), self.count(vr::LOAD_COLUMN));
+        (row < grid.rows).then(|| grid.node(grid.rows - 1 - row, col)).flatten()
+    }
+
+    /// Why the load node (loadRow, loadColumn) cannot carry the point load
+    /// in the grid these values describe: outside it, or held.
+    pub fn load_node_problem(&self) -> Option<String> {
+        let (row, col) = (self.count(vr::LOAD_ROW), self.count(vr::LOAD_COLUMN));
+        let grid = self.grid();
+        match self.load_node() {
+            None => Some(format!(
+                "loadRow = {row}, loadColumn = {col} is outside the grid of ny = {} rows and nx = {} columns (rows count from the bottom edge; set nx and ny first, or in the same call)",
+                grid.rows, grid.columns
+            )),
+            Some(node) if grid.is_held(node) => {
+                Some(format!("loadRow = {row}, loadColumn = {col} is a held node (fixedNodes = {}); choose a free node", grid.fixed_nodes.name()))
+            }
+            Some(_) => None,
+        }
+    }
+
+    /// The load node's column follows the middle of the bottom row,
+    /// nx / 2 rounded down, until the host chooses it.
+    pub(super) fn follow_middle_column(&mut self) {
+        let middle = (self.scalar(vr::NX) / 2.0).floor();
+        self.set(vr::LOAD_COLUMN, &[middle]);
+    }
+
+    /// Set-up: the grid, then the simulator (assembly, eigen decomposition).
+    pub fn build(&self) -> Result<Simulator, PhysicsError> {
+        self.build_with(None)
+    }
+
+    /// Set-up with the costly part taken from a baked `prebuilt` when given.
+    pub fn build_with(&self, prebuilt: Option<&SetupData>) -> Result<Simulator, PhysicsError> {
+        let scene = self.grid().build()?;
+        if self.load_node_problem().is_some() {
+            return Err(PhysicsError::LoadNode { node: self.load_node(), held: self.load_node().is_some() });
+        }
+        Simulator::with_setup(scene, &self.settings(), &self.loads(), prebuilt)
+    }
+}

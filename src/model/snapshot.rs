@@ -1,0 +1,50 @@
+//! The simulator's part of a serialized FMU state (the payload's tail in
+//! [`crate::fmi::serialize`]): time, y, y', y'', the anchor and its rate,
+//! then the loads: gravity, point load, load node, anchor target, damping,
+//! weights.
+
+use crate::fmi::serialize::{put_f64, put_f64s, put_u64, Reader};
+use crate::physics::{Loads, Snapshot, State};
+
+pub fn write(snap: &Snapshot, p: &mut Vec<u8>) {
+    let s = &snap.state;
+    put_f64(p, s.time);
+    put_f64s(p, &s.y);
+    put_f64s(p, &s.v);
+    put_f64s(p, &s.a);
+    s.anchor.iter().chain(&s.anchor_rate).for_each(|x| put_f64(p, *x));
+    let l = &snap.loads;
+    l.gravity.iter().for_each(|g| put_f64(p, *g));
+    l.point_load.iter().for_each(|f| put_f64(p, *f));
+    put_u64(p, l.load_node.map_or(u64::MAX, |n| n as u64));
+    l.anchor.iter().for_each(|a| put_f64(p, *a));
+    put_f64(p, l.damping_alpha);
+    put_f64(p, l.damping_beta);
+    put_f64s(p, &l.mode_weights);
+}
+
+pub fn read(r: &mut Reader) -> Result<Snapshot, String> {
+    let (time, y, v, a) = (r.f64()?, r.f64s()?, r.f64s()?, r.f64s()?);
+    let (anchor, anchor_rate) = ([r.f64()?, r.f64()?, r.f64()?], [r.f64()?, r.f64()?, r.f64()?]);
+    let state = State { time, y, v, a, anchor, anchor_rate };
+    let gravity = [r.f64()?, r.f64()?, r.f64()?];
+    let point_load = [r.f64()?, r.f64()?, r.f64()?];
+    let load_node = match r.u64()? {
+        u64::MAX => None,
+        n => Some(usize::try_from(n).map_err(|_| "load node out of range".to_string())?),
+    };
+    let anchor = [r.f64()?, r.f64()?, r.f64()?];
+    if !anchor.iter().all(|a| a.is_finite()) {
+        return Err("the anchor target holds non-finite values".into());
+    }
+    let damping_alpha = r.f64()?;
+    let damping_beta = r.f64()?;
+    let mode_weights = r.f64s()?;
+    if !(state.is_finite() && state.time >= 0.0) {
+        return Err("the simulator state holds a negative or non-finite time or non-finite values".into());
+    }
+    if state.v.len() != state.y.len() || state.a.len() != state.y.len() {
+        return Err(format!("the simulator state holds arrays of {}, {} and {} values", state.y.len(), state.v.len(), state.a.len()));
+    }
+    Ok(Snapshot { state, loads: Loads { gravity, point_load, load_node, anchor, damping_alpha, damping_beta, mode_weights } })
+}
