@@ -4,50 +4,18 @@
 //! once set-up is done. Only allocations of the thread that steps count (the
 //! test harness's own threads allocate when they please).
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
-use std::sync::atomic::{AtomicUsize, Ordering};
+#[path = "common/counting.rs"]
+mod counting;
 
+use counting::allocations;
 use modal_mass_spring::physics::*;
 use modal_mass_spring::scenes;
-
-struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-thread_local! {
-    /// Set on the thread whose allocations count.
-    static WATCHED: Cell<bool> = const { Cell::new(false) };
-}
-
-fn count() {
-    if WATCHED.with(Cell::get) {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-    }
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        count();
-        unsafe { System.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        unsafe { System.dealloc(p, l) }
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        count();
-        unsafe { System.realloc(p, l, n) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
 
 /// Every space and scheme, with the paper's basis and with each option
 /// (modes chosen by the load, static correction, linearization at the
 /// equilibrium, cubature forces).
 #[test]
 fn do_step_allocates_nothing() {
-    WATCHED.with(|w| w.set(true));
     // (mode selection, static correction, linearization, force evaluation): the paper's first.
     use ForceEvaluation::{Cubature, Exact};
     use Linearization::{Equilibrium, Rest};
@@ -77,26 +45,26 @@ fn do_step_allocates_nothing() {
                     };
                     sim.do_step(0.01).unwrap(); // first step may factorise
                     let mut loads = sim.loads().clone();
-                    let before = ALLOCATIONS.load(Ordering::SeqCst);
-                    for k in 0..20 {
-                        sim.do_step(0.01).unwrap();
-                        if k % 2 == 0 {
-                            // The outputs computed on demand, read on every other step.
-                            let x = sim.positions()[0] + sim.velocities()[0] + sim.potential_energy() + sim.force_residual();
-                            let x = x + sim.load_node_position().unwrap()[0] + sim.load_node_velocity().unwrap()[1] + sim.anchor_force()[1];
-                            assert!(x.is_finite());
+                    let n = allocations(|| {
+                        for k in 0..20 {
+                            sim.do_step(0.01).unwrap();
+                            if k % 2 == 0 {
+                                // The outputs computed on demand, read on every other step.
+                                let x = sim.positions()[0] + sim.velocities()[0] + sim.potential_energy() + sim.force_residual();
+                                let x = x + sim.load_node_position().unwrap()[0] + sim.load_node_velocity().unwrap()[1] + sim.anchor_force()[1];
+                                assert!(x.is_finite());
+                            }
                         }
-                    }
-                    // A load change between steps derives the load terms again, without allocating.
-                    loads.point_load = [-0.01, -0.03, 0.0];
-                    sim.set_loads(&loads).unwrap();
-                    sim.do_step(0.01).unwrap();
-                    // A moving anchor (a kick of the rates) and another step size.
-                    loads.anchor = [0.001, 0.0, 0.0];
-                    sim.set_loads(&loads).unwrap();
-                    sim.do_step(0.007).unwrap();
-                    assert!(sim.anchor_force()[1].is_finite());
-                    let n = ALLOCATIONS.load(Ordering::SeqCst) - before;
+                        // A load change between steps derives the load terms again, without allocating.
+                        loads.point_load = [-0.01, -0.03, 0.0];
+                        sim.set_loads(&loads).unwrap();
+                        sim.do_step(0.01).unwrap();
+                        // A moving anchor (a kick of the rates) and another step size.
+                        loads.anchor = [0.001, 0.0, 0.0];
+                        sim.set_loads(&loads).unwrap();
+                        sim.do_step(0.007).unwrap();
+                        assert!(sim.anchor_force()[1].is_finite());
+                    });
                     assert_eq!(n, 0, "{name} {reduction:?} {integrator:?} {mode_selection:?} {static_correction} {linearization:?} {force_evaluation:?}: {n} allocations in 20 steps and the outputs read");
                 }
             }

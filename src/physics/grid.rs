@@ -147,24 +147,29 @@ impl Grid {
     }
 }
 
+/// The paper's sheet of `columns` x `rows` nodes (spacing 0.1 m, 0.01 kg,
+/// 50 N/m, shear springs; auxiliary springs of 0.05 N/m in 3D), for tests.
+#[cfg(test)]
+pub(crate) fn paper(columns: usize, rows: usize, dim: usize, fixed_nodes: FixedNodes) -> Grid {
+    Grid {
+        columns,
+        rows,
+        dim,
+        spacing: 0.1,
+        node_mass: 0.01,
+        spring_stiffness: 50.0,
+        shear_springs: true,
+        bending_springs: false,
+        aux_stiffness: if dim == 3 { 0.05 } else { 0.0 },
+        fixed_nodes,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn grid(columns: usize, rows: usize, dim: usize, fixed_nodes: FixedNodes) -> Grid {
-        Grid {
-            columns,
-            rows,
-            dim,
-            spacing: 0.1,
-            node_mass: 0.01,
-            spring_stiffness: 50.0,
-            shear_springs: true,
-            bending_springs: false,
-            aux_stiffness: if dim == 3 { 0.05 } else { 0.0 },
-            fixed_nodes,
-        }
-    }
+    use super::paper as grid;
 
     #[test]
     fn paper_grid_counts() {

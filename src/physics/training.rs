@@ -284,7 +284,7 @@ fn poses(space: &Modal<Exact>, set_up: &Loads, settings: &Settings) -> Result<(V
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::physics::grid::{FixedNodes, Grid};
+    use crate::physics::grid::{paper, FixedNodes, Grid};
     use crate::physics::settings::{ForceEvaluation, Integrator, ModeSelection, Reduction};
     use crate::physics::space::{Cubature, ForceSetup, Modes, ReducedForce};
 
@@ -292,18 +292,7 @@ mod tests {
     fn sheet(name: &str) -> (Grid, Loads) {
         let dim = if name.contains("3d") { 3 } else { 2 };
         let (columns, rows) = if dim == 3 { (7, 7) } else { (10, 10) };
-        let grid = Grid {
-            columns,
-            rows,
-            dim,
-            spacing: 0.1,
-            node_mass: 0.01,
-            spring_stiffness: 50.0,
-            shear_springs: true,
-            bending_springs: false,
-            aux_stiffness: if dim == 3 { 0.05 } else { 0.0 },
-            fixed_nodes: FixedNodes::TopRow,
-        };
+        let grid = paper(columns, rows, dim, FixedNodes::TopRow);
         let loads = Loads::physical(6);
         (grid, loads)
     }
