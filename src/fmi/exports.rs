@@ -29,6 +29,8 @@ fn panic_message(p: &Box<dyn std::any::Any + Send>) -> String {
 /// poisons the instance and returns fmi3Fatal.
 fn call(instance: fmi3Instance, f: F, body: impl FnOnce(&mut Instance) -> Result<fmi3Status, fmi3Status>) -> fmi3Status {
     let Some(inst) = (unsafe { registry::get(instance) }) else {
+        // No instance, so no logger: the refusal goes to stderr.
+        eprintln!("{}: {instance:p} is not a live instance of this FMU (NULL, freed, or not made by it); refused", f.name());
         return ERROR;
     };
     if inst.poisoned {

@@ -4,6 +4,7 @@
 
 use std::ffi::CStr;
 use std::panic::catch_unwind;
+use std::sync::Once;
 
 use fmi_sys::fmi3::*;
 
@@ -13,6 +14,22 @@ use super::logging::log_raw;
 use super::params::Params;
 use super::variables::INSTANTIATION_TOKEN;
 use super::{registry, ERROR, FATAL, OK};
+
+/// Keeps this library in memory for the rest of the process, once: a host
+/// that closes it (dlclose) and opens it again while instances live (Ecos
+/// does, for a second instance of the same FMU file) would otherwise unload
+/// it and with it every live instance, whose pointers the reopened library
+/// would then refuse. The library asks the loader for itself again with
+/// `RTLD_NODELETE` (and never closes that handle).
+fn pin_library() {
+    static PIN: Once = Once::new();
+    PIN.call_once(|| unsafe {
+        let mut info: libc::Dl_info = std::mem::zeroed();
+        if libc::dladdr(pin_library as *const libc::c_void, &mut info) != 0 && !info.dli_fname.is_null() {
+            libc::dlopen(info.dli_fname, libc::RTLD_NOW | libc::RTLD_NOLOAD | libc::RTLD_NODELETE);
+        }
+    });
+}
 
 /// Checks the arguments and makes an instance with the start values of
 /// `resources/startValues.txt` (or the compiled ones).
@@ -31,6 +48,7 @@ pub unsafe fn co_simulation(
     logger: fmi3LogMessageCallback,
 ) -> fmi3Instance {
     const F: &str = "fmi3InstantiateCoSimulation";
+    pin_library();
     let result = catch_unwind(|| {
         let fail = |m: String| {
             log_raw(env, logger, ERROR, "logStatusError", &format!("{F}: {m}"));
