@@ -51,6 +51,11 @@ fn uniform(rng: &mut ChaCha8Rng) -> f64 {
     (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
+/// A chosen spring with its columns on the training and the held-out poses.
+type Chosen<const D: usize> = (Candidate<D>, Vec<f64>, Vec<f64>);
+/// Modal coordinates of a set of poses.
+type Poses = Vec<Vec<f64>>;
+
 /// The costly part of a cubature set-up: the basis `settings` ask for (or
 /// that of `prebuilt`), and the spring set trained on it, as data for
 /// `Modal::<Cubature>::new`.
@@ -109,7 +114,7 @@ fn select<const D: usize>(space: &Modal<Exact>, tol: f64, train_poses: &[Vec<f64
     let mut rng = ChaCha8Rng::seed_from_u64(SEED ^ 1);
     let (mt, mh) = (train_t.len(), held_t.len());
     // Chosen springs with their training and held-out columns.
-    let mut chosen: Vec<(Candidate<D>, Vec<f64>, Vec<f64>)> = Vec::new();
+    let mut chosen: Vec<Chosen<D>> = Vec::new();
     let mut weights: Vec<f64> = Vec::new();
     let mut residual = train_t.clone();
     let mut held_residual = held_t.clone();
@@ -172,7 +177,7 @@ fn select<const D: usize>(space: &Modal<Exact>, tol: f64, train_poses: &[Vec<f64
             keep
         });
         weights.retain(|w| *w > 0.0);
-        let apply = |target: &[f64], col: fn(&(Candidate<D>, Vec<f64>, Vec<f64>)) -> &Vec<f64>, out: &mut Vec<f64>| {
+        let apply = |target: &[f64], col: fn(&Chosen<D>) -> &Vec<f64>, out: &mut Vec<f64>| {
             out.copy_from_slice(target);
             for (c, w) in chosen.iter().zip(&weights) {
                 for (o, a) in out.iter_mut().zip(col(c)) {
@@ -205,7 +210,7 @@ fn select<const D: usize>(space: &Modal<Exact>, tol: f64, train_poses: &[Vec<f64
 /// The weights of the chosen springs: the non-negative least-squares fit
 /// of their columns to `target` (Lawson-Hanson), on columns scaled to unit
 /// norm.
-fn fit<const D: usize>(chosen: &[(Candidate<D>, Vec<f64>, Vec<f64>)], target: &[f64]) -> Result<Vec<f64>, PhysicsError> {
+fn fit<const D: usize>(chosen: &[Chosen<D>], target: &[f64]) -> Result<Vec<f64>, PhysicsError> {
     let norms: Vec<f64> = chosen.iter().map(|c| norm(&c.1)).collect();
     let a = Array2::from_shape_fn((target.len(), chosen.len()), |(i, j)| chosen[j].1[i] / norms[j]);
     let b = Array1::from(target.to_vec());
@@ -225,7 +230,7 @@ fn fit<const D: usize>(chosen: &[(Candidate<D>, Vec<f64>, Vec<f64>)], target: &[
 /// in [0.5, 1.25], delta_j uniform within a quarter of mode j's amplitude in
 /// the run. With no motion (no load), the amplitude is 1 % of a whole-sheet
 /// displacement by the scene's length scale.
-fn poses(space: &Modal<Exact>, set_up: &Loads, settings: &Settings) -> Result<(Vec<Vec<f64>>, Vec<Vec<f64>>), PhysicsError> {
+fn poses(space: &Modal<Exact>, set_up: &Loads, settings: &Settings) -> Result<(Poses, Poses), PhysicsError> {
     let (scene, modes) = (space.scene(), space.modes());
     let r = modes.basis.r;
     let mut loads = Loads { damping_alpha: 0.0, damping_beta: 0.0, anchor: [0.0; 3], mode_weights: vec![1.0; r], ..set_up.clone() };
