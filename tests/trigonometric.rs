@@ -12,6 +12,7 @@ use common::*;
 use modal_mass_spring::fmi::variables::vr;
 use modal_mass_spring::physics::engine::{Engine, Stepper};
 use modal_mass_spring::physics::error::StepFailure;
+use modal_mass_spring::physics::frame::Moments;
 use modal_mass_spring::physics::integrator::{Propagator, Trigonometric};
 use modal_mass_spring::physics::space::{Diagonal, Layout, Readout, Space};
 use modal_mass_spring::physics::*;
@@ -239,6 +240,17 @@ impl Readout for Linear {
     }
     fn momentum(&self, _v: &[f64]) -> [f64; 3] {
         [0.0; 3]
+    }
+    fn first_moment(&self, _y: &[f64]) -> [f64; 3] {
+        [0.0; 3]
+    }
+    fn moments(&self, _y: &[f64], _v: &[f64]) -> Moments {
+        Moments::default()
+    }
+    fn undamped_acceleration(&self, v: &[f64], a: &[f64], w: &mut LinearWork, z: &mut [f64]) {
+        for i in 0..z.len() {
+            z[i] = a[i] + w.damping[i] * v[i];
+        }
     }
     fn dof_velocities(&self, _v: &[f64], _out: &mut [f64]) {}
     fn modal_coordinates(&self, y: &[f64], out: &mut [f64]) {

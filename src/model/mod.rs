@@ -153,6 +153,7 @@ impl Model for MassSpring {
                 Computed::Scalar(component(sim.load_node_velocity(), (r - vr::LOAD_NODE_V_X) as usize))
             }
             vr::ANCHOR_FORCE_X | vr::ANCHOR_FORCE_Y | vr::ANCHOR_FORCE_Z => Computed::Scalar(sim.anchor_force()[(r - vr::ANCHOR_FORCE_X) as usize]),
+            vr::ANCHOR_TORQUE_X | vr::ANCHOR_TORQUE_Y | vr::ANCHOR_TORQUE_Z => Computed::Scalar(sim.anchor_torque()[(r - vr::ANCHOR_TORQUE_X) as usize]),
             _ => unreachable!("value reference {r} is not computed"),
         }
     }

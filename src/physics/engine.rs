@@ -11,7 +11,7 @@ use std::marker::PhantomData;
 
 use super::bake::SetupData;
 use super::error::{PhysicsError, StepFailure};
-use super::forces::pull;
+use super::frame::Moments;
 use super::integrator::{Buffers, NewmarkExplicit, NewmarkImplicit, Scheme, Trigonometric};
 use super::scene::Scene;
 use super::settings::{ForceEvaluation, Integrator, Reduction, Settings};
@@ -106,7 +106,7 @@ pub trait Probe {
     /// Coordinates of the kept or reported modes.
     fn modal_coordinates(&self, state: &State, out: &mut [f64]);
     /// Node positions of `state` (whose forces were evaluated last) into
-    /// `out.positions`, and the anchor force (which follows from them).
+    /// `out.positions`.
     fn node_positions(&mut self, state: &State, out: &mut Outputs);
     /// Node velocities of `state` into `out.velocities` (held nodes at 0).
     fn node_velocities(&mut self, state: &State, out: &mut Outputs);
@@ -115,9 +115,17 @@ pub trait Probe {
     fn node_position(&mut self, state: &State, node: usize) -> [f64; 3];
     /// Velocity of one node of `state` (0 for a held node); z is 0 in 2D.
     fn node_velocity(&self, state: &State, node: usize) -> [f64; 3];
-    /// The anchor force of `state` from the springs that touch a held node
-    /// alone, without the other positions.
-    fn anchor_force(&mut self, state: &State) -> [f64; 3];
+    /// First mass moment of the free nodes about the pivot at `state.y`
+    /// (see [`Readout::first_moment`]) [kg m].
+    fn first_moment(&self, state: &State) -> [f64; 3];
+    /// sum M z over the free nodes per axis, z = y'' + M^-1 C y' of the
+    /// motion the scheme integrates at `state` (whose forces were evaluated
+    /// last; see [`Scheme::acceleration`]): what the free nodes' forces
+    /// other than damping sum to, with the damping's share [N].
+    fn driven_momentum(&mut self, state: &State) -> [f64; 3];
+    /// The mass moments at `state`: of the rates, and of z as above
+    /// (see [`Readout::moments`]).
+    fn moments(&mut self, state: &State) -> (Moments, Moments);
     /// Elastic energy of every spring plus gravity potential at `state` [J].
     fn potential_energy(&mut self, loads: &Loads, state: &State) -> f64;
     /// The force the space cannot represent at `state`, relative to the load.
@@ -141,9 +149,11 @@ pub struct Outputs {
     pub potential: f64,
     /// The part of the force the space cannot represent, relative to the load.
     pub force_residual: f64,
-    /// The force the sheet exerts on its held nodes: the sum of the spring
-    /// forces acting on them (`docs/method.md`, section 8) [N]; z is 0 in 2D.
+    /// The force the sheet exerts on its holder, from the momentum balance
+    /// (`docs/method.md`, section 8) [N]; z is 0 in 2D.
     pub anchor_force: [f64; 3],
+    /// The torque the sheet exerts on its holder about the pivot [N m].
+    pub anchor_torque: [f64; 3],
 }
 
 impl Outputs {
@@ -158,6 +168,7 @@ impl Outputs {
             potential: 0.0,
             force_residual: 0.0,
             anchor_force: [0.0; 3],
+            anchor_torque: [0.0; 3],
         }
     }
 }
@@ -167,54 +178,26 @@ pub struct Engine<S: Readout, I: Scheme> {
     space: S,
     work: S::Work,
     buffers: Buffers,
-    /// The springs with one end on a held node: (held slot, other slot,
-    /// stiffness, rest length), for the anchor force.
-    anchors: Vec<(usize, usize, f64, f64)>,
+    /// y'' of the scheme's motion and z = y'' + M^-1 C y', for the holder's force and torque.
+    acceleration: Vec<f64>,
+    driven: Vec<f64>,
     scheme: PhantomData<I>,
 }
 
 impl<S: Readout, I: Scheme> Engine<S, I> {
     /// Binds `space` to the scheme, or refuses a space the scheme cannot integrate.
     pub fn new(space: S) -> Result<Self, PhysicsError> {
-        let anchors = anchor_springs(space.scene());
         let work = space.work();
         I::check(&space, &work)?;
-        Ok(Engine { work, buffers: Buffers::new(space.layout().coordinates, I::SCRATCH), anchors, space, scheme: PhantomData })
+        let n = space.layout().coordinates;
+        Ok(Engine { work, buffers: Buffers::new(n, I::SCRATCH), acceleration: vec![0.0; n], driven: vec![0.0; n], space, scheme: PhantomData })
     }
-}
 
-/// The springs of `scene` with one end on a held node (a node of the
-/// output that is not free; the anchor points of auxiliary springs are not
-/// nodes): (held slot, other slot, stiffness, rest length).
-fn anchor_springs(scene: &Scene) -> Vec<(usize, usize, f64, f64)> {
-    let mut held = vec![false; scene.rest.len() / scene.dim];
-    for &slot in &scene.slot_of_node {
-        held[slot] = slot >= scene.n_free;
+    /// z = y'' + M^-1 C y' of the scheme's motion at `state` into `self.driven`.
+    fn drive(&mut self, state: &State) {
+        I::acceleration(&self.space, &mut self.work, &mut self.buffers, state, &mut self.acceleration);
+        self.space.undamped_acceleration(&state.v, &self.acceleration, &mut self.work, &mut self.driven);
     }
-    let mut anchors = Vec::new();
-    for s in &scene.springs {
-        if held[s.a] {
-            anchors.push((s.a, s.b, s.k, s.rest));
-        }
-        if held[s.b] {
-            anchors.push((s.b, s.a, s.k, s.rest));
-        }
-    }
-    anchors
-}
-
-/// Sum over `anchors` of the force each spring exerts on its held end,
-/// with `at(slot)` the position of a slot ([`pull`] on the held end).
-fn anchor_force(anchors: &[(usize, usize, f64, f64)], d: usize, mut at: impl FnMut(usize) -> [f64; 3]) -> [f64; 3] {
-    let mut f = [0.0; 3];
-    for &(held, other, k, rest) in anchors {
-        let (xh, xo) = (at(held), at(other));
-        let pulled = pull(&std::array::from_fn::<f64, 3, _>(|i| xo[i] - xh[i]), k, rest);
-        for i in 0..d {
-            f[i] += pulled[i];
-        }
-    }
-    f
 }
 
 impl<S: Readout, I: Scheme> Stepper for Engine<S, I> {
@@ -294,8 +277,7 @@ impl<S: Readout, I: Scheme> Probe for Engine<S, I> {
 
     fn node_positions(&mut self, state: &State, out: &mut Outputs) {
         let scene = self.space.scene();
-        let (d, x) = (scene.dim, self.space.positions(&state.y, &mut self.work));
-        out.anchor_force = anchor_force(&self.anchors, d, |slot| std::array::from_fn(|i| if i < d { x[slot * d + i] } else { 0.0 }));
+        let x = self.space.positions(&state.y, &mut self.work);
         match scene.dim {
             2 => to_node_order::<2>(&scene.slot_of_node, usize::MAX, x, &mut out.positions),
             _ => to_node_order::<3>(&scene.slot_of_node, usize::MAX, x, &mut out.positions),
@@ -325,9 +307,18 @@ impl<S: Readout, I: Scheme> Probe for Engine<S, I> {
         }
     }
 
-    fn anchor_force(&mut self, state: &State) -> [f64; 3] {
-        let (space, work) = (&self.space, &mut self.work);
-        anchor_force(&self.anchors, space.scene().dim, |slot| space.slot_position(&state.y, slot, work))
+    fn first_moment(&self, state: &State) -> [f64; 3] {
+        self.space.first_moment(&state.y)
+    }
+
+    fn driven_momentum(&mut self, state: &State) -> [f64; 3] {
+        self.drive(state);
+        self.space.momentum(&self.driven)
+    }
+
+    fn moments(&mut self, state: &State) -> (Moments, Moments) {
+        self.drive(state);
+        (self.space.moments(&state.y, &state.v), self.space.moments(&state.y, &self.driven))
     }
 
     fn potential_energy(&mut self, loads: &Loads, state: &State) -> f64 {

@@ -11,6 +11,7 @@
 //! - [`integrator`]: the schemes (explicit and implicit Newmark), written
 //!   once against [`space::Space`];
 //! - [`engine`]: a space and a scheme bound together;
+//! - [`frame`]: the holder's frame and the mass moments of the sheet in it;
 //! - [`state`]: [`State`] and [`Loads`], what changes while running;
 //! - [`simulator`]: set-up, sub-stepping, divergence checks, outputs;
 //! - [`training`]: the cubature's training, a set-up stage that runs the exact reduced model;
@@ -26,6 +27,7 @@ pub mod engine;
 pub mod equilibrium;
 pub mod error;
 pub mod forces;
+pub mod frame;
 pub mod grid;
 pub mod integrator;
 pub mod modes;

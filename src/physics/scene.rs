@@ -65,6 +65,13 @@ impl Scene {
         Ok(())
     }
 
+    /// The pivot X0: the rest position of node 0 (z 0 in 2D), about which
+    /// the holder turns and its torque is taken (`docs/method.md`, section 8).
+    pub fn pivot(&self) -> [f64; 3] {
+        let (d, slot) = (self.dim, self.slot_of_node[0]);
+        std::array::from_fn(|i| if i < d { self.rest[slot * d + i] } else { 0.0 })
+    }
+
     /// Total mass of the free nodes [kg].
     pub fn free_mass(&self) -> f64 {
         self.dof_mass.iter().step_by(self.dim).sum()

@@ -14,6 +14,7 @@
 use super::bake::SetupData;
 use super::engine::{self, Outputs, Stepper};
 use super::error::{positive, Expected, PhysicsError, Quantity, StepFailure};
+use super::frame::cross;
 use super::scene::Scene;
 use super::settings::{Reduction, Settings};
 use super::state::{Loads, Snapshot, State};
@@ -49,8 +50,9 @@ pub fn internal_step_count(h: f64, dt_max: f64) -> f64 {
 #[derive(Clone, Copy, Debug, Default)]
 struct Fresh {
     positions: bool,
-    /// The anchor force (also computed with the positions).
+    /// The holder's force and torque.
     anchor: bool,
+    torque: bool,
     velocities: bool,
     potential: bool,
     residual: bool,
@@ -298,16 +300,45 @@ impl Simulator {
         let v = self.engine.node_velocity(&self.state, node);
         Some(std::array::from_fn(|i| if i < d { v[i] + self.state.anchor_rate[i] } else { 0.0 }))
     }
-    /// The force the sheet exerts on its held nodes, the sum of the spring
-    /// forces acting on them (`docs/method.md`, section 8); z is 0 in 2D
-    /// [N]. Computed with the node positions, or alone from the springs that
-    /// touch a held node when the positions are not asked for.
+    /// The force the sheet exerts on its holder, from the momentum balance
+    /// of the free nodes (`docs/method.md`, section 8):
+    /// F = m_free g + f_p - sum M z, z = y'' + M^-1 C y' of the motion the
+    /// scheme integrates, so the damping's reaction is the holder's and, in
+    /// 3D, so is what the auxiliary springs carry (their points ride with
+    /// the holder). O(r) in the modal space; z is 0 in 2D [N].
     pub fn anchor_force(&mut self) -> [f64; 3] {
-        if !self.fresh.positions && !self.fresh.anchor {
-            self.outputs.anchor_force = self.engine.anchor_force(&self.state);
+        if !self.fresh.anchor {
+            let driven = self.engine.driven_momentum(&self.state);
+            let (d, g, f) = (self.scene().dim, self.loads.gravity, self.point_load());
+            self.outputs.anchor_force = std::array::from_fn(|i| if i < d { self.free_mass * g[i] + f[i] - driven[i] } else { 0.0 });
             self.fresh.anchor = true;
         }
         self.outputs.anchor_force
+    }
+    /// The torque the sheet exerts on its holder about the pivot, from the
+    /// balance of angular momentum (`docs/method.md`, section 8):
+    /// S x g + rho_p x f_p - sum m rho x z; only z in 2D. O(r^2) in the modal space [N m].
+    pub fn anchor_torque(&mut self) -> [f64; 3] {
+        if !self.fresh.torque {
+            let (_, driven) = self.engine.moments(&self.state);
+            let d = self.scene().dim;
+            let g: [f64; 3] = std::array::from_fn(|i| if i < d { self.loads.gravity[i] } else { 0.0 });
+            let mut t = cross(&driven.first, &g);
+            let f = self.point_load();
+            if let Some(node) = self.loads.load_node.filter(|_| f != [0.0; 3]) {
+                let (x, pivot) = (self.engine.node_position(&self.state, node), self.scene().pivot());
+                let arm = cross(&std::array::from_fn(|i| x[i] - pivot[i]), &f);
+                t = std::array::from_fn(|i| t[i] + arm[i]);
+            }
+            let inertial = driven.angular();
+            self.outputs.anchor_torque = std::array::from_fn(|i| if d == 3 || i == 2 { t[i] - inertial[i] } else { 0.0 });
+            self.fresh.torque = true;
+        }
+        self.outputs.anchor_torque
+    }
+    /// The point load where it acts, on a free load node (z 0 in 2D), else 0 [N].
+    fn point_load(&self) -> [f64; 3] {
+        self.loads.point_force(self.scene()).map_or([0.0; 3], |(_, f)| std::array::from_fn(|i| f.get(i).copied().unwrap_or(0.0)))
     }
     /// Coordinates of the kept (modal) or reported (full) modes.
     pub fn modal_coordinates(&self) -> &[f64] {
@@ -349,8 +380,7 @@ impl Simulator {
     pub fn potential_energy(&mut self) -> f64 {
         if !self.fresh.potential {
             // The anchor's displacement a moves every free node: -(m g + f_p) . a more.
-            let d = self.scene().dim;
-            let point = self.loads.point_force(self.scene()).map_or([0.0; 3], |(_, f)| std::array::from_fn(|i| f.get(i).copied().unwrap_or(0.0)));
+            let (d, point) = (self.scene().dim, self.point_load());
             let shifted: f64 = (0..d).map(|i| (self.free_mass * self.loads.gravity[i] + point[i]) * self.state.anchor[i]).sum();
             self.outputs.potential = self.engine.potential_energy(&self.loads, &self.state) - shifted;
             self.fresh.potential = true;

@@ -43,6 +43,14 @@ pub trait Scheme: Send + 'static {
         Self::settle(space, w, buf, loads, state);
     }
 
+    /// The acceleration y'' of the motion the scheme integrates, at
+    /// `state`, into `out`, with the forces of `w` evaluated at `state.y`
+    /// (the holder's force and torque follow from it, `docs/method.md`,
+    /// section 8). Newmark keeps it in `state.a`.
+    fn acceleration<S: Space>(_space: &S, _w: &mut S::Work, _buf: &mut Buffers, state: &State, out: &mut [f64]) {
+        out.copy_from_slice(&state.a);
+    }
+
     /// After the internal steps of a communication step: leaves the forces
     /// of `w` evaluated at `state.y`, where the outputs and the step guard
     /// read them. Nothing for a scheme whose last evaluation is there.

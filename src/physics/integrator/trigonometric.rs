@@ -46,7 +46,7 @@ pub struct Trigonometric;
 
 /// Per coordinate in [`Buffers::scheme`]: lambda, c and dt, and the
 /// [`Propagator`] of the three, computed again only when one changes.
-const CACHE: usize = 10;
+const CACHE: usize = 11;
 
 /// The kicks integrate the rest of the force explicitly: like the
 /// central difference, they follow a stiffness K of it while dt^2 K < 4.
@@ -83,7 +83,7 @@ impl Scheme for Trigonometric {
                 let (y, v, b) = (state.y[i], state.v[i] + kick * state.a[i], d.load[i]);
                 buf.y1[i] = p.yy * y + p.yv * v + p.yg * b;
                 buf.v1[i] = p.vy * y + p.vv * v + p.yv * b;
-                buf.r[i] = kick;
+                buf.r[i] = 0.5 * dt * p.kick_end;
                 buf.a1[i] = p.filter * buf.y1[i];
             }
         }
@@ -118,6 +118,28 @@ impl Scheme for Trigonometric {
     /// e does not depend on the rates; the forces are still at `state.y`.
     fn settle_rates<S: Space>(_space: &S, _w: &mut S::Work, _buf: &mut Buffers, _loads: &Loads, _state: &mut State) {}
 
+    /// The motion the scheme integrates: at a fixed point of its step
+    /// (y1 = y, v = 0) the exact propagator gives lambda I y = I b + P dt/2 psi_1 e,
+    /// so its equations are y'' + c y' + lambda y = b + kappa e(phi y) with
+    /// kappa = P dt psi_1 / (2 I) (chi(xi) undamped, 1 as dt -> 0), and
+    /// y'' = b + kappa e_n - lambda y - c v, which is 0 at its rest. Before
+    /// e_n is known for a step size (after a change of loads or a restored
+    /// state): h(y) - c v, with the forces at y.
+    fn acceleration<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, state: &State, out: &mut [f64]) {
+        let dt = buf.filter_step;
+        let d = diagonal(space, w);
+        for i in 0..out.len() {
+            let (lambda, c) = (d.stiffness[i], d.damping[i]);
+            out[i] = if dt.is_finite() {
+                let p = cached(&mut buf.scheme[i * CACHE..(i + 1) * CACHE], lambda, c, dt);
+                let kappa = p.yv * dt * p.kick / (2.0 * p.yg);
+                d.load[i] + kappa * state.a[i] - lambda * state.y[i] - c * state.v[i]
+            } else {
+                buf.h[i] - c * state.v[i]
+            };
+        }
+    }
+
     /// The step's evaluation is at phi y: once more at y for the outputs.
     fn finish<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, loads: &Loads, state: &State) {
         space.force(loads, &state.y, w, &mut buf.h);
@@ -127,10 +149,10 @@ impl Scheme for Trigonometric {
 /// The propagator of (lambda, c, dt), from `cache` when it holds those.
 fn cached(cache: &mut [f64], lambda: f64, c: f64, dt: f64) -> Propagator {
     if cache[0] == lambda && cache[1] == c && cache[2] == dt {
-        return Propagator { yy: cache[3], yv: cache[4], yg: cache[5], vy: cache[6], vv: cache[7], filter: cache[8], kick: cache[9] };
+        return Propagator { yy: cache[3], yv: cache[4], yg: cache[5], vy: cache[6], vv: cache[7], filter: cache[8], kick: cache[9], kick_end: cache[10] };
     }
     let p = Propagator::new(lambda, c, dt);
-    cache.copy_from_slice(&[lambda, c, dt, p.yy, p.yv, p.yg, p.vy, p.vv, p.filter, p.kick]);
+    cache.copy_from_slice(&[lambda, c, dt, p.yy, p.yv, p.yg, p.vy, p.vv, p.filter, p.kick, p.kick_end]);
     p
 }
 
@@ -171,7 +193,14 @@ pub const EPSILON: f64 = 0.3;
 /// and the filters of the rest of the force at xi = dt sqrt(lambda): it is
 /// evaluated at `filter` y, filter = phi(xi) = sinc(xi), and kicks the rates
 /// by dt/2 `kick` e, kick = psi_1(xi) = sinc(xi/2) cos(xi/2) / (cos^2(xi/2) + EPSILON^2 sin^2(xi/2)),
-/// so that sinc(xi) psi_1(xi) = sinc^2(xi/2) chi(xi).
+/// so that sinc(xi) psi_1(xi) = sinc^2(xi/2) chi(xi). The closing kick is
+/// dt/2 `kick_end` e with kick_end = kick (P^2 / I - V_v): with a constant
+/// rest e the step then has the rest of y'' + c y' + lambda y = b + kappa e,
+/// kappa = P dt kick / (2 I), at zero rate (the position update asks
+/// lambda I y = I b + P dt/2 kick e, the rate update
+/// lambda P y = P b + (V_v kick + kick_end) dt/2 e). Undamped,
+/// P^2 = I (1 + V_v) and kick_end = kick; with equal kicks a damped sheet
+/// would settle at a position with a spurious rate, of order c dt^2 e.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Propagator {
     pub yy: f64,
@@ -181,6 +210,7 @@ pub struct Propagator {
     pub vv: f64,
     pub filter: f64,
     pub kick: f64,
+    pub kick_end: f64,
 }
 
 impl Propagator {
@@ -191,7 +221,10 @@ impl Propagator {
         let x = xi(lambda, dt);
         let (sin, cos) = (0.5 * x).sin_cos();
         let kick = sinc(0.5 * x) * cos / (cos * cos + EPSILON * EPSILON * sin * sin);
-        Propagator { yy: u.yy, yv: s, yg: u.i * dt * dt, vy: -lambda * s, vv: u.ds, filter: sinc(x), kick }
+        let yg = u.i * dt * dt;
+        // Undamped the ratio is 1: kept exact so undamped runs do not depend on its round-off.
+        let kick_end = if c == 0.0 { kick } else { kick * (s * s / yg - u.ds) };
+        Propagator { yy: u.yy, yv: s, yg, vy: -lambda * s, vv: u.ds, filter: sinc(x), kick, kick_end }
     }
 }
 

@@ -4,6 +4,7 @@
 
 use crate::physics::bake::SetupData;
 use crate::physics::error::StepFailure;
+use crate::physics::frame::Moments;
 use crate::physics::scene::Scene;
 use crate::physics::state::Loads;
 
@@ -131,6 +132,15 @@ pub trait Readout: Space {
     fn kinetic_energy(&self, v: &[f64]) -> f64;
     /// Momentum of the free nodes per axis, sum_k m_k v_k, at rates `v` [kg m/s].
     fn momentum(&self, v: &[f64]) -> [f64; 3];
+    /// S = sum m_k (x_k - X0) over the free nodes at y, the first mass
+    /// moment about the pivot in the holder's frame (O(r) in the modal space) [kg m].
+    fn first_moment(&self, y: &[f64]) -> [f64; 3];
+    /// The mass moments of the free nodes about the pivot at coordinates y
+    /// and rates v (see [`Moments`]; O(r^2) in the modal space).
+    fn moments(&self, y: &[f64], v: &[f64]) -> Moments;
+    /// z = a + M^-1 C v: the acceleration the forces other than damping
+    /// give, with the damping's reaction on the holder (`docs/method.md`, section 8).
+    fn undamped_acceleration(&self, v: &[f64], a: &[f64], w: &mut Self::Work, z: &mut [f64]);
     /// Velocities of the free DOFs.
     fn dof_velocities(&self, v: &[f64], out: &mut [f64]);
     /// Coordinates of the kept or reported modes at y.

@@ -20,6 +20,7 @@ use super::equations::{Diagonal, Layout, Readout, Space};
 use crate::physics::basis;
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::forces::{linearize, omega_sq_bound_full, SpringForces, SpringScratch, StiffnessPattern};
+use crate::physics::frame::{add_outer, Moments};
 use crate::physics::modes::ModalBasis;
 use crate::physics::scene::Scene;
 use crate::physics::settings::Settings;
@@ -327,6 +328,39 @@ impl Readout for Full {
             p[k % d] += m * vk;
         }
         p
+    }
+
+    fn first_moment(&self, u: &[f64]) -> [f64; 3] {
+        let (d, pivot, mut s) = (self.scene.dim, self.scene.pivot(), [0.0; 3]);
+        for (k, (uk, m)) in u.iter().zip(&self.scene.dof_mass).enumerate() {
+            s[k % d] += m * (self.scene.rest[k] + uk - pivot[k % d]);
+        }
+        s
+    }
+
+    /// Node by node, rho = x_rest + u - X0.
+    fn moments(&self, u: &[f64], v: &[f64]) -> Moments {
+        let (d, pivot) = (self.scene.dim, self.scene.pivot());
+        let mut out = Moments::default();
+        for (k, m) in self.scene.dof_mass.iter().step_by(d).enumerate() {
+            let rho: [f64; 3] = std::array::from_fn(|i| if i < d { self.scene.rest[k * d + i] + u[k * d + i] - pivot[i] } else { 0.0 });
+            let vel: [f64; 3] = std::array::from_fn(|i| if i < d { v[k * d + i] } else { 0.0 });
+            for i in 0..3 {
+                out.first[i] += m * rho[i];
+                out.momentum[i] += m * vel[i];
+            }
+            add_outer(&mut out.second, *m, &rho, &rho);
+            add_outer(&mut out.flux, *m, &vel, &rho);
+        }
+        out
+    }
+
+    /// z = a + M^-1 C v.
+    fn undamped_acceleration(&self, v: &[f64], a: &[f64], w: &mut FullWork, z: &mut [f64]) {
+        self.damping_times(v, w);
+        for k in 0..z.len() {
+            z[k] = a[k] + w.cv[k] / self.scene.dof_mass[k];
+        }
     }
 
     fn dof_velocities(&self, v: &[f64], out: &mut [f64]) {

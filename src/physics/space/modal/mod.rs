@@ -22,10 +22,12 @@ use faer::{Conj, Mat, MatMut, Par};
 
 mod cubature;
 mod exact;
+mod inertia;
 mod reduced;
 
 pub use cubature::{Candidate, Cubature};
 pub use exact::Exact;
+pub use inertia::Inertia;
 pub use reduced::{taut_reduced_bound, ForceSetup, Modes, ReducedForce};
 
 use super::equations::{Diagonal, Layout, Readout, Space};
@@ -33,6 +35,7 @@ use crate::physics::bake::SetupData;
 use crate::physics::basis;
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::forces::omega_sq_bound_full;
+use crate::physics::frame::Moments;
 use crate::physics::modes::ModalBasis;
 use crate::physics::scene::Scene;
 use crate::physics::settings::Settings;
@@ -56,9 +59,8 @@ pub struct Modal<F: ReducedForce = Exact> {
     newton_scale: f64,
     /// 1 / m_k per free DOF.
     inv_mass: Vec<f64>,
-    /// Phi^T M e_i for each axis i (r x 3, row-major): the modal rates of a
-    /// unit rigid translation of the free nodes along axis i.
-    translation: Vec<f64>,
+    /// The mass moments of the free nodes as polynomials in q.
+    inertia: Inertia,
 }
 
 /// Load terms and scratch of a modal run.
@@ -111,14 +113,8 @@ impl<F: ReducedForce> Modal<F> {
         let force = F::new(&scene, &modes, &setup)?;
         let omega_sq_bound = force.taut_bound(&scene, &modes).map_or(bound, |b| b.max(bound));
         let inv_mass = scene.dof_mass.iter().map(|m| 1.0 / m).collect();
-        let (n, r, d) = (modes.basis.n, modes.basis.r, scene.dim);
-        let mut translation = vec![0.0; r * 3];
-        for (j, col) in modes.cols.chunks_exact(n).enumerate() {
-            for (k, (p, m)) in col.iter().zip(&scene.dof_mass).enumerate() {
-                translation[j * 3 + k % d] += p * m;
-            }
-        }
-        Ok(Modal { force, frequencies, omega_sq_bound, bound, newton_scale, inv_mass, translation, modes, scene })
+        let inertia = Inertia::new(&scene, &modes);
+        Ok(Modal { force, frequencies, omega_sq_bound, bound, newton_scale, inv_mass, inertia, modes, scene })
     }
 
     /// The kept modes.
@@ -298,7 +294,8 @@ impl<F: ReducedForce> Space for Modal<F> {
     /// q' += w_i Phi^T M (1 c): a rigid velocity c of the free nodes,
     /// projected and weighted like every load.
     fn add_translation_rate(&self, loads: &Loads, c: &[f64; 3], v: &mut [f64]) {
-        for (j, (vj, t)) in v.iter_mut().zip(self.translation.chunks_exact(3)).enumerate() {
+        for (j, vj) in v.iter_mut().enumerate() {
+            let t = self.inertia.translation(j);
             *vj += loads.mode_weights[j] * (t[0] * c[0] + t[1] * c[1] + t[2] * c[2]);
         }
     }
@@ -401,13 +398,22 @@ impl<F: ReducedForce> Readout for Modal<F> {
 
     /// sum_k m_k e_k (Phi q')_k = sum_j (Phi^T M e)_j q'_j per axis.
     fn momentum(&self, v: &[f64]) -> [f64; 3] {
-        let mut p = [0.0; 3];
-        for (vj, t) in v.iter().zip(self.translation.chunks_exact(3)) {
-            for i in 0..3 {
-                p[i] += t[i] * vj;
-            }
+        self.inertia.momentum(v)
+    }
+
+    fn first_moment(&self, q: &[f64]) -> [f64; 3] {
+        self.inertia.first_moment(q)
+    }
+
+    fn moments(&self, q: &[f64], v: &[f64]) -> Moments {
+        self.inertia.moments(q, v)
+    }
+
+    /// z = a + diag(c) v.
+    fn undamped_acceleration(&self, v: &[f64], a: &[f64], w: &mut Self::Work, z: &mut [f64]) {
+        for j in 0..z.len() {
+            z[j] = a[j] + w.damping[j] * v[j];
         }
-        p
     }
 
     /// Phi q'.

@@ -1,0 +1,68 @@
+//! The holder's frame and the mass moments of the sheet in it
+//! (`docs/method.md`, section 8).
+//!
+//! The sheet is integrated in the frame of its holder: a slot at x in that
+//! frame is at X = p + R (x - X0) in the ground's, with X0 the pivot (the
+//! rest position of node 0), p = X0 + a the pivot carried by the anchor's
+//! translation a, and R the holder's orientation. Whatever the space, the
+//! forces and torques the sheet exerts on its holder follow from a few mass
+//! moments of the free nodes about the pivot ([`Moments`]), which the modal
+//! space computes from invariants of its basis without expanding a node.
+//!
+//! Vectors have 3 components (z = 0 in 2D); 3 x 3 tensors are row-major.
+
+/// Mass moments of the free nodes about the pivot, at positions x and
+/// rates v, rho_k = x_k - X0 (in the holder's frame):
+///
+/// ```text
+///     S = sum m_k rho_k,            J = sum m_k rho_k (x) rho_k,
+///     P = sum m_k v_k,              N = sum m_k v_k (x) rho_k,
+///     L = sum m_k rho_k x v_k  (read from N: L_c = eps_cab N_ba).
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Moments {
+    /// S [kg m].
+    pub first: [f64; 3],
+    /// J [kg m^2].
+    pub second: [f64; 9],
+    /// P [kg m/s].
+    pub momentum: [f64; 3],
+    /// N [kg m^2/s].
+    pub flux: [f64; 9],
+}
+
+impl Moments {
+    /// L = sum m_k rho_k x v_k, the antisymmetric part of N.
+    pub fn angular(&self) -> [f64; 3] {
+        let n = &self.flux;
+        [n[7] - n[5], n[2] - n[6], n[3] - n[1]]
+    }
+}
+
+/// a x b.
+#[inline]
+pub fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+/// a . b.
+#[inline]
+pub fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// A b for a row-major 3 x 3 tensor A.
+#[inline]
+pub fn apply(a: &[f64; 9], b: &[f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| a[3 * i] * b[0] + a[3 * i + 1] * b[1] + a[3 * i + 2] * b[2])
+}
+
+/// Adds s (u (x) w) to the row-major tensor `t`.
+#[inline]
+pub fn add_outer(t: &mut [f64; 9], s: f64, u: &[f64; 3], w: &[f64; 3]) {
+    for i in 0..3 {
+        for j in 0..3 {
+            t[3 * i + j] += s * u[i] * w[j];
+        }
+    }
+}
