@@ -103,7 +103,7 @@ def assert_bitwise(run, ref, names, ecos_name=lambda n: n):
 
 
 @pytest.fixture(scope="module")
-def sheet_a_fmu():
+def sheet_a_fmu(tmp_path_factory):
     """An FMU file with sheet A's grid (its structural parameters as start
     values); rebuilt when older than the default FMU."""
     p = chain.SHEETS["A"]
@@ -113,11 +113,17 @@ def sheet_a_fmu():
         subprocess.run(cmd + ["--out", str(path)], cwd=ROOT, check=True)
     md = {v.name: v for v in read_model_description(str(path)).modelVariables}
     assert [int(md[k].start) for k in ("nx", "ny", "nModes")] == [p["nx"], p["ny"], p["nModes"]]
+    UNZIPPED[str(path)] = str(tmp_path_factory.mktemp("sheet_a"))
+    extract(str(path), UNZIPPED[str(path)])
     return path
 
 
+# FMU path -> where it is extracted for fmpy_instance
+UNZIPPED = {}
+
+
 def fmpy_instance(path, name="s"):
-    return Instance(read_model_description(str(path)), extract(str(path)), name=name)
+    return Instance(read_model_description(str(path)), UNZIPPED[str(path)], name=name)
 
 
 # -- one instance ----------------------------------------------------------------
@@ -125,7 +131,7 @@ def fmpy_instance(path, name="s"):
 SINGLE = {"dampingAlpha": 5.0, "maxInternalStep": 2.0**-12, "springStiffness": 40.0, "loadX": 0.3, "loadY": -0.2}
 
 
-def test_single_instance_is_fmpy_bit_for_bit(default_fmu, capfd):
+def test_single_instance_is_fmpy_bit_for_bit(default_fmu, default_md, unzipped, capfd):
     """The default FMU in Ecos, its parameters and inputs from a parameter
     set (applied in Initialization Mode), h = 1/256 s up to 2 s: every
     scalar output at every communication point is the one of fmpy's run
@@ -134,7 +140,7 @@ def test_single_instance_is_fmpy_bit_for_bit(default_fmu, capfd):
     e = ecos_run({"s": default_fmu}, h, stop, {f"s::{k}": v for k, v in SINGLE.items()}, [f"s::{n}" for n in SCALARS])
     logged = fmu_messages(capfd.readouterr().out)
 
-    inst = fmpy_instance(default_fmu)
+    inst = Instance(default_md, unzipped, name="s")
     try:
         inst.slave.enterInitializationMode(startTime=0.0)
         for k, v in SINGLE.items():
