@@ -7,12 +7,14 @@
 //!   `fmi-rs`), `valgrind` (`cargo xtask valgrind`), `libclang-rt-dev`
 //!   (the libFuzzer runtime `cargo xtask fuzz` links) and what the reference
 //!   importer fmusim is built with (`cargo xtask fmusim`): `gcc`,
-//!   `libsundials-dev`, `libminizip-dev`, `zlib1g-dev` and `libxml2-dev`.
+//!   `libsundials-dev`, `libminizip-dev`, `zlib1g-dev` and `libxml2-dev`;
+//!   `libtbb12`, which Ecos's library (ecospy) links.
 //! - The Python environment `.venv` in the repository root: fmpy, numpy and
 //!   matplotlib to run the main job; dask.distributed for parameter sweeps
 //!   (`cargo xtask sweep`, python/sweep.py); for the tests pytest and
 //!   fmu-manipulation-toolbox (its `fmucontainer` is one of the co-simulation
-//!   masters `tests/python/test_chain.py` runs the FMU under).
+//!   masters `tests/python/test_chain.py` runs the FMU under) and ecospy
+//!   (the Ecos co-simulation engine, `tests/python/test_ecos.py`).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -41,6 +43,8 @@ const DEBIAN_PACKAGES: &[(&str, Purpose)] = &[
     ("libsundials-dev", Purpose::Test),
     ("libminizip-dev", Purpose::Test),
     ("zlib1g-dev", Purpose::Test),
+    // ecospy's libecosc.so (Ecos, tests/python/test_ecos.py)
+    ("libtbb12", Purpose::Test),
 ];
 
 /// Python packages: (distribution name as pip knows it, requirement to
@@ -55,6 +59,7 @@ const PYTHON_PACKAGES: &[(&str, &str, Purpose)] = &[
     ("distributed", "dask[distributed]==2026.8.0", Purpose::Sweep),
     ("pytest", "pytest", Purpose::Test),
     ("fmu_manipulation_toolbox", "fmu_manipulation_toolbox==2.0", Purpose::Test),
+    ("ecospy", "ecospy==0.7.2", Purpose::Test),
 ];
 
 pub fn root() -> PathBuf {
