@@ -1,6 +1,8 @@
 """Two sheets in a chain: sheet B hangs from the load node of sheet A.
 
     .venv/bin/python python/chain.py [FMU] [--step 0.015625] [--stop-time 3] [--out out/chain.png]
+        [--coupling explicit|jacobi|aitken|iqn-ils] [--sheets default|full|modes20|modes8]
+        [--tol 1e-10] [--max-iter 50] [--hold mean|end] [--reuse 8]
 
 Both sheets are instances of the same FMU. The coupling is
 
@@ -11,7 +13,10 @@ The masters here:
 
 - `run_master`: a plain loop over fmpy's FMU3Slave, Jacobi (both sheets step
   from the outputs at the start of the step) or Gauss-Seidel (A steps first,
-  then B's anchor is set to where A's load node ended the step, then B steps);
+  then B's anchor is set to where A's load node ended the step, then B steps),
+  or implicit (python/coupling.py: each step repeated from saved FMU states
+  until B's pull and A's load node agree, accelerated by Aitken's relaxation
+  or IQN-ILS);
 - `fmpy_container`: the same pair packed by fmpy's `container_fmu` (Jacobi)
   and run as one FMU with `simulate_fmu`;
 - `fmt_container`: the same pair packed by fmu-manipulation-toolbox's

@@ -11,6 +11,11 @@ anchor then moves by A.loadNode - A.loadNode(0): the plain master with
 anchor="absolute" does the same, and the two conventions differ by
 round-off in B's coordinates.
 
+Implicit coupling (python/coupling.py) on the stiff pairs of 6 x 6 sheets
+(full space, 20 modes): it runs at h = 0.01 s, where both explicit orders
+are discarded, and converges to the limit of the explicit chain as h
+halves; where the explicit chain becomes stable.
+
 Every tolerance below is derived from the numbers these tests print (run
 pytest with -s): the container runs are bit for bit the plain master with
 the same coupling order; the coupling error is first order in the
