@@ -429,6 +429,8 @@ def main(argv=None):
                     help="implicit: A's load over a step is the mean of B's pull at its ends, or the pull at its end")
     ap.add_argument("--reuse", type=int, default=8, help="IQN-ILS: earlier steps whose columns are reused")
     args = ap.parse_args(argv)
+    if args.max_iter < 1 or not args.tol > 0.0 or args.reuse < 0:
+        ap.error("--max-iter must be at least 1, --tol above 0, --reuse not negative")
     scheme = "gauss-seidel" if args.coupling == "explicit" else args.coupling
     implicit = {}
     if scheme in IMPLICIT:

@@ -39,10 +39,10 @@ preCICE does for the data of its second participant):
 
 The step has converged when |r^k| <= tol |H^k| (relative). The other
 interface value, A's load node at t_k + h, is a function of f within the
-step, so it has converged with f. An unconverged step after `max_iter`
-evaluations raises NotConverged. The FMUs are then at t_k + h with the inputs of the
-last evaluation: the accepted step is one the FMUs took, never a
-recombination.
+step, so it has converged with f. A converged step leaves the FMUs at
+t_k + h with the inputs of the last evaluation: the accepted step is one
+the FMUs took, never a recombination. A step not converged after
+`max_iter` evaluations raises NotConverged.
 """
 
 import time
@@ -199,6 +199,8 @@ def implicit_step(a, b, t, h, offset, acc, stats, tol=1e-10, max_iter=50, hold="
     """
     if hold not in ("mean", "end"):
         raise ValueError(f"unknown hold {hold!r}: mean or end")
+    if max_iter < 1:
+        raise ValueError(f"max_iter = {max_iter}: at least one evaluation a step")
     clock = time.perf_counter()
     tick = time.perf_counter()
     states = [a.slave.getFMUState(), b.slave.getFMUState()]
