@@ -1,6 +1,8 @@
 """Two sheets in a chain: sheet B hangs from the load node of sheet A.
 
     .venv/bin/python python/chain.py [FMU] [--step 0.015625] [--stop-time 3] [--out out/chain.png]
+        [--coupling explicit|jacobi|aitken|iqn-ils] [--sheets default|full|modes20|modes8]
+        [--tol 1e-10] [--max-iter 50] [--hold mean|end] [--reuse 8]
 
 Both sheets are instances of the same FMU. The coupling is
 
@@ -11,7 +13,10 @@ The masters here:
 
 - `run_master`: a plain loop over fmpy's FMU3Slave, Jacobi (both sheets step
   from the outputs at the start of the step) or Gauss-Seidel (A steps first,
-  then B's anchor is set to where A's load node ended the step, then B steps);
+  then B's anchor is set to where A's load node ended the step, then B steps),
+  or implicit (python/coupling.py: each step repeated from saved FMU states
+  until B's pull and A's load node agree, accelerated by Aitken's relaxation
+  or IQN-ILS);
 - `fmpy_container`: the same pair packed by fmpy's `container_fmu` (Jacobi)
   and run as one FMU with `simulate_fmu`;
 - `fmt_container`: the same pair packed by fmu-manipulation-toolbox's
@@ -31,6 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
+import coupling
+
 ROOT = Path(__file__).resolve().parents[1]
 
 # The two sheets (structural and fixed parameters of each instance). B hangs
@@ -45,6 +52,24 @@ SHEETS = {
 # every communication step size, so runs at different steps differ only in
 # the coupling.
 COMMON = {"dampingAlpha": 5.0, "maxInternalStep": 2.0**-12}
+# A stiff pair: 6 x 6 sheets of equal mass and stiffness, B's 1.5 kg on one
+# node of A, where passing the force one step late feeds in energy at
+# h = 0.01 s until the FMU discards the step (Jacobi and Gauss-Seidel).
+STIFF_A = {"nx": 6, "ny": 6, "loadColumn": 2, "springStiffness": 50.0, "nodeMass": 0.05}
+STIFF_B = {"nx": 6, "ny": 6, "springStiffness": 50.0, "nodeMass": 0.05}
+# The pairs --sheets chooses: "default" is SHEETS; the stiff pair in full
+# space (reduction = full, 2) and with 20 and 8 modes.
+SHEET_SETS = {
+    "default": SHEETS,
+    "full": {"A": {**STIFF_A, "reduction": 2}, "B": {**STIFF_B, "reduction": 2}},
+    "modes20": {"A": {**STIFF_A, "nModes": 20}, "B": {**STIFF_B, "nModes": 20}},
+    "modes8": {"A": {**STIFF_A, "nModes": 8}, "B": {**STIFF_B, "nModes": 8}},
+}
+# Parameters of enumeration type (set with fmi3SetInt64).
+ENUMERATIONS = {"reduction"}
+# Couplings: explicit orders, and implicit with an acceleration (python/coupling.py).
+EXPLICIT = ("jacobi", "gauss-seidel")
+IMPLICIT = ("aitken", "iqn-ils")
 # The coupling: (output of one sheet, input of the other).
 LINKS = [("A", "loadNodeX", "B", "anchorX"), ("A", "loadNodeY", "B", "anchorY"),
          ("B", "anchorForceX", "A", "loadX"), ("B", "anchorForceY", "A", "loadY")]
@@ -62,16 +87,17 @@ def default_fmu():
     return ROOT / "target" / "fmu" / "ModalMassSpring.fmu"
 
 
-def free_mass(sheet):
+def free_mass(sheet, sheets="default"):
     """Mass of the free nodes (every row but the held top row) [kg]."""
-    p = SHEETS[sheet]
+    p = SHEET_SETS[sheets][sheet]
     return (p["ny"] - 1) * p["nx"] * p["nodeMass"]
 
 
 class Sheet:
-    """One instance of the FMU, its variables by name."""
+    """One instance of the FMU, its variables by name; p its parameters
+    (default SHEETS[name])."""
 
-    def __init__(self, fmu, unzipdir, md, name):
+    def __init__(self, fmu, unzipdir, md, name, p=None):
         from fmpy.fmi3 import FMU3Slave
 
         self.vr = {v.name: v.valueReference for v in md.modelVariables}
@@ -79,8 +105,11 @@ class Sheet:
         self.slave = FMU3Slave(guid=md.guid, unzipDirectory=unzipdir,
                                modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
         self.slave.instantiate(logMessage=lambda env, status, cat, msg: self.messages.append(msg.decode()))
-        p = SHEETS[name]
-        ints = [k for k, v in p.items() if isinstance(v, int)]
+        self.p = p = SHEETS[name] if p is None else p
+        enums = [k for k in p if k in ENUMERATIONS]
+        if enums:
+            self.slave.setInt64([self.vr[k] for k in enums], [p[k] for k in enums])
+        ints = [k for k, v in p.items() if isinstance(v, int) and k not in ENUMERATIONS]
         floats = [k for k, v in p.items() if isinstance(v, float)] + list(COMMON)
         self.slave.setUInt64([self.vr[k] for k in ints], [p[k] for k in ints])
         self.slave.setFloat64([self.vr[k] for k in floats], [{**p, **COMMON}[k] for k in floats])
@@ -96,24 +125,36 @@ class Sheet:
         self.slave.freeInstance()
 
 
-def run_master(fmu, h, stop, scheme="jacobi", anchor="relative", positions=False):
+class StepRefused(RuntimeError):
+    """A sheet refused a communication step (fmi3Discard or fmi3Error);
+    the message holds what the FMU logged last."""
+
+
+def run_master(fmu, h, stop, scheme="jacobi", anchor="relative", positions=False, sheets="default", **implicit):
     """The pair with a plain master at constant communication step h.
 
-    scheme: "jacobi" or "gauss-seidel" (A first). anchor: "relative"
+    scheme: "jacobi" or "gauss-seidel" (A first), or implicit coupling,
+    "aitken" or "iqn-ils" (python/coupling.py, options in implicit: tol,
+    max_iter and those of the acceleration). sheets: a key of SHEET_SETS.
+    anchor: "relative"
     (B.anchor = A.loadNode - A.loadNode(0), B starts at its own rest
     position) or "absolute" (B.anchor = A.loadNode, B starts at rest hanging
     from A's load node: what a container does). Returns {"time": ...,
     "A.loadNodeY": ..., ...} at every communication point, t = 0 included;
     with positions also "A.positions" and "B.positions" (time, ny, nx, 2);
     "A.restNode", A's load node at rest, and "messages", what the FMUs
-    logged.
+    logged; implicit coupling adds "iterations" (evaluations per step) and
+    "stats" (coupling.Stats.summary()). A refused step raises StepRefused,
+    an implicit step that does not converge coupling.NotConverged.
     """
     from fmpy import extract, read_model_description
+    from fmpy.fmi1 import FMICallException
 
     md = read_model_description(str(fmu))
     unzipdir = extract(str(fmu))
-    a, b = Sheet(fmu, unzipdir, md, "A"), Sheet(fmu, unzipdir, md, "B")
-    sheets = {"A": a, "B": b}
+    pair = SHEET_SETS[sheets]
+    a, b = Sheet(fmu, unzipdir, md, "A", pair["A"]), Sheet(fmu, unzipdir, md, "B", pair["B"])
+    by_name = {"A": a, "B": b}
     try:
         p0 = np.array(a.get("loadNodeX", "loadNodeY"))
         offset = np.zeros(2) if anchor == "absolute" else p0
@@ -127,10 +168,10 @@ def run_master(fmu, h, stop, scheme="jacobi", anchor="relative", positions=False
         per_sheet = {s: [name[2:] for name in RECORDED if name[0] == s] for s in "AB"}
 
         def record(t):
-            values = {s: dict(zip(per_sheet[s], sheets[s].get(*per_sheet[s]))) for s in "AB"}
+            values = {s: dict(zip(per_sheet[s], by_name[s].get(*per_sheet[s]))) for s in "AB"}
             rows.append([t] + [values[name[0]][name[2:]] for name in RECORDED])
             if positions:
-                frames.append([positions_of(sheets[s], s) for s in "AB"])
+                frames.append([positions_of(by_name[s], s) for s in "AB"])
 
         def exchange_load():
             a.set(["loadX", "loadY"], b.get("anchorForceX", "anchorForceY"))
@@ -143,20 +184,22 @@ def run_master(fmu, h, stop, scheme="jacobi", anchor="relative", positions=False
         exchange_load()
         exchange_anchor()
         record(0.0)
+        if scheme in IMPLICIT:
+            acc, settings, stats = implicit_setup(scheme, implicit)
+        elif scheme not in EXPLICIT:
+            raise ValueError(f"unknown scheme {scheme}")
         for k in range(int(round(stop / h))):
             t = k * h
-            if scheme == "jacobi":
-                a.slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-                b.slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-                exchange_load()
-                exchange_anchor()
-            elif scheme == "gauss-seidel":
-                a.slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-                exchange_anchor()
-                b.slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-                exchange_load()
-            else:
-                raise ValueError(f"unknown scheme {scheme}")
+            try:
+                if scheme in IMPLICIT:
+                    coupling.implicit_step(a, b, t, h, offset, acc, stats, **settings)
+                    # B's force at the end of the step predicts A's load over the next
+                    exchange_load()
+                else:
+                    explicit_step(a, b, t, h, scheme, exchange_load, exchange_anchor)
+            except FMICallException as e:
+                said = (a.messages + b.messages)[-1:] or [str(e)]
+                raise StepRefused(f"{scheme} chain, step from t = {t:g} s by {h:g} s: {said[0]}") from e
             record((k + 1) * h)
     finally:
         a.free()
@@ -169,11 +212,37 @@ def run_master(fmu, h, stop, scheme="jacobi", anchor="relative", positions=False
             out[f"{s}.positions"] = np.array([f[i] for f in frames])
     out["A.restNode"] = p0
     out["messages"] = a.messages + b.messages
+    if scheme in IMPLICIT:
+        out["iterations"] = np.array(stats.iterations)
+        out["stats"] = stats.summary()
     return out
 
 
+def implicit_setup(scheme, options):
+    """(acceleration, settings of coupling.implicit_step, stats) of an
+    implicit coupling: tol, max_iter and hold from options, the rest of them
+    for the acceleration (initial, reuse, drop)."""
+    settings = {k: options[k] for k in ("tol", "max_iter", "hold") if k in options}
+    rest = {k: v for k, v in options.items() if k not in settings}
+    return coupling.accelerator(scheme, **rest), settings, coupling.Stats()
+
+
+def explicit_step(a, b, t, h, scheme, exchange_load, exchange_anchor):
+    """One step of an explicit master: Jacobi or Gauss-Seidel (A first)."""
+    if scheme == "jacobi":
+        a.slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+        b.slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+        exchange_load()
+        exchange_anchor()
+    else:
+        a.slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+        exchange_anchor()
+        b.slave.doStep(currentCommunicationPoint=t, communicationStepSize=h)
+        exchange_load()
+
+
 def positions_of(sheet, name):
-    nx, ny = SHEETS[name]["nx"], SHEETS[name]["ny"]
+    nx, ny = sheet.p["nx"], sheet.p["ny"]
     return np.array(sheet.slave.getFloat64([sheet.vr["positions"]], nValues=nx * ny * 2)).reshape(ny, nx, 2)
 
 
@@ -289,7 +358,7 @@ def run_container(path, h, stop):
     return out
 
 
-def plot(r, path):
+def plot(r, path, sheets="default"):
     import matplotlib
 
     matplotlib.use("Agg")
@@ -301,7 +370,7 @@ def plot(r, path):
     # the sheets at rest, at B's lowest point and at the end; B drawn hanging
     # from A's load node, centred under it
     ax = axes[0]
-    dx = -(SHEETS["B"]["nx"] - 1) / 2 * 0.1
+    dx = -(SHEET_SETS[sheets]["B"]["nx"] - 1) / 2 * 0.1
     lowest = int(np.argmin(r["B.loadNodeY"]))
     frames = [(0, ":", 0.5), (lowest, "--", 0.7), (len(t) - 1, "-", 1.0)]
     for k, style, alpha in frames:
@@ -349,13 +418,41 @@ def main(argv=None):
     ap.add_argument("--step", type=float, default=2.0**-6, help="communication step [s]")
     ap.add_argument("--stop-time", type=float, default=3.0)
     ap.add_argument("--out", default=str(ROOT / "out" / "chain.png"))
+    ap.add_argument("--coupling", choices=["explicit", "jacobi", *IMPLICIT], default="explicit",
+                    help="explicit (Gauss-Seidel, A first), jacobi, or implicit with Aitken's relaxation or IQN-ILS")
+    ap.add_argument("--sheets", choices=list(SHEET_SETS), default="default",
+                    help="the pair: default (5x4 and 3x3, every mode), or the stiff 6x6 pair in full space, "
+                         "with 20 or with 8 modes")
+    ap.add_argument("--tol", type=float, default=1e-10, help="implicit: relative tolerance on the interface residual")
+    ap.add_argument("--max-iter", type=int, default=50, help="implicit: iterations per step at most")
+    ap.add_argument("--hold", choices=["mean", "end"], default="mean",
+                    help="implicit: A's load over a step is the mean of B's pull at its ends, or the pull at its end")
+    ap.add_argument("--reuse", type=int, default=8, help="IQN-ILS: earlier steps whose columns are reused")
     args = ap.parse_args(argv)
-    r = run_master(args.fmu, args.step, args.stop_time, scheme="gauss-seidel", positions=True)
+    if args.max_iter < 1 or not args.tol > 0.0 or args.reuse < 0:
+        ap.error("--max-iter must be at least 1, --tol above 0, --reuse not negative")
+    scheme = "gauss-seidel" if args.coupling == "explicit" else args.coupling
+    implicit = {}
+    if scheme in IMPLICIT:
+        implicit = {"tol": args.tol, "max_iter": args.max_iter, "hold": args.hold}
+        if scheme == "iqn-ils":
+            implicit["reuse"] = args.reuse
+    try:
+        r = run_master(args.fmu, args.step, args.stop_time, scheme=scheme, positions=True, sheets=args.sheets,
+                       **implicit)
+    except (StepRefused, coupling.NotConverged) as e:
+        sys.exit(f"chain.py: {e}")
     e = total_energy(r)
-    print(f"chain, Gauss-Seidel, h = {args.step} s: at t = {r['time'][-1]:.2f} s A's load node sags "
+    print(f"chain ({args.sheets} sheets), {scheme}, h = {args.step} s: at t = {r['time'][-1]:.2f} s A's load node sags "
           f"{r['A.loadNodeY'][0] - r['A.loadNodeY'][-1]:.4f} m, B pulls with {-r['A.loadY'][-1]:.4f} N "
-          f"(B's weight {free_mass('B') * 9.81:.4f} N), energy {e[-1]:.5f} J")
-    plot(r, args.out)
+          f"(B's weight {free_mass('B', args.sheets) * 9.81:.4f} N), energy {e[-1]:.5f} J")
+    if scheme in IMPLICIT:
+        st = r["stats"]
+        print(f"iterations per step: mean {st['mean_iterations']:.2f}, max {st['max_iterations']} "
+              f"({st['steps']} steps); fmi3GetFMUState {st['save_us']:.1f} us, fmi3SetFMUState "
+              f"{st['restore_us']:.1f} us per sheet (median), {100 * st['state_share']:.1f} % of the time of a step "
+              f"({st['step_ms']:.3f} ms, median)")
+    plot(r, args.out, args.sheets)
     print(f"plot: {args.out}")
 
 
