@@ -37,7 +37,7 @@ fn column(b: &Basis, j: usize) -> Vec<f64> {
 fn load_selection_leaves_out_what_gravity_does_not_excite() {
     // 2D, top row fixed: the lowest mode is a sideways sway, orthogonal to gravity along -y.
     let (s, lowest) = build("paper-2d-top-row", 1, &paper());
-    let g = basis::load_patterns(&s, &Loads::physical(0), false).remove(0);
+    let g = basis::load_patterns(&s, &Loads::physical(0), false, false).remove(0);
     let sway = column(&lowest, 0);
     let gnorm = g.iter().zip(&s.dof_mass).map(|(f, m)| f * f / m).sum::<f64>().sqrt();
     let driven: f64 = sway.iter().zip(&g).map(|(a, b)| a * b).sum::<f64>() / gnorm;
@@ -116,7 +116,7 @@ fn outside(s: &Scene, b: &Basis, u: &[f64]) -> f64 {
 fn the_static_correction_holds_the_sag() {
     // At rest: the static response K^-1 M g.
     let (s, b) = build("paper-2d-top-row", 4, &options(ModeSelection::Load, true, Linearization::Rest));
-    let g = basis::load_patterns(&s, &Loads::physical(0), false).remove(0);
+    let g = basis::load_patterns(&s, &Loads::physical(0), false, false).remove(0);
     let (_, all) = build("paper-2d-top-row", s.n_dofs(), &paper());
     // K^-1 M g from every mode: sum phi (phi^T M g) / lambda.
     let mut sag = vec![0.0; s.n_dofs()];
@@ -146,7 +146,7 @@ fn the_equilibrium_balances_gravity_and_matches_a_damped_run() {
         let s = setup.grid.build().unwrap();
         let pattern = StiffnessPattern::new(&s);
         let x = equilibrium(&s, &pattern, &modal_mass_spring::physics::basis::external_load(&s, &setup.loads)).unwrap();
-        let mut f: Vec<f64> = basis::load_patterns(&s, &setup.loads, false).remove(0);
+        let mut f: Vec<f64> = basis::load_patterns(&s, &setup.loads, false, false).remove(0);
         let gravity = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let springs = SpringForces::new(&s);
         springs.add_to(&s, &x, &mut springs.scratch(&s), &mut f);

@@ -247,11 +247,6 @@ impl Readout for Linear {
     fn moments(&self, _y: &[f64], _v: &[f64]) -> Moments {
         Moments::default()
     }
-    fn undamped_acceleration(&self, v: &[f64], a: &[f64], w: &mut LinearWork, z: &mut [f64]) {
-        for i in 0..z.len() {
-            z[i] = a[i] + w.damping[i] * v[i];
-        }
-    }
     fn dof_velocities(&self, _v: &[f64], _out: &mut [f64]) {}
     fn modal_coordinates(&self, y: &[f64], out: &mut [f64]) {
         out.copy_from_slice(y);

@@ -31,7 +31,7 @@ pub const MAGIC: &[u8; 8] = b"MMSFMU3S";
 /// simulator state as time and three arrays (y, y', y'') instead of one
 /// concatenated array; 4: the point load and its node among the loads,
 /// the anchor's position and rate in the state and its target among the loads.
-pub const VERSION: u32 = 4;
+pub const VERSION: u32 = 5;
 /// Bytes before the payload.
 pub const HEADER: usize = 8 + 4 + 8 + 8;
 /// Bytes after the payload.

@@ -21,6 +21,7 @@ pub fn variable(q: Quantity) -> &'static str {
         Quantity::Gravity => "gravity",
         Quantity::PointLoad => "loadX, loadY, loadZ",
         Quantity::Anchor => "anchorX, anchorY, anchorZ",
+        Quantity::Rotation => "anchorRX, anchorRY, anchorRZ",
         Quantity::DampingAlpha => "dampingAlpha",
         Quantity::DampingBeta => "dampingBeta",
         Quantity::ModeWeights => "modeWeights",
@@ -123,6 +124,13 @@ pub fn describe(e: &PhysicsError, p: &Params) -> String {
             integrator(Integrator::NewmarkExplicit),
             integrator(Integrator::NewmarkImplicit),
         ),
+        SchemeCannotTurn { scheme } => format!(
+            "{} integrates forces of the positions alone; a turning holder (anchorRX, anchorRY, anchorRZ changing in Step Mode) adds \
+             the Coriolis force, which depends on the rates: use {} or {} (a holder turned before initialization and kept still is accepted)",
+            integrator(*scheme),
+            integrator(Integrator::NewmarkExplicit),
+            integrator(Integrator::NewmarkImplicit),
+        ),
         SnapshotLength { len, expected } => format!("the state holds {len} values per array, this scene needs {expected}"),
         SnapshotNotFinite => "the state holds non-finite values".into(),
     }
@@ -137,6 +145,12 @@ fn failure(cause: &StepFailure) -> String {
              move relative to it by more than half the spacing per internal step of {dt:e} s (limit {limit:e} m/s); move the anchor \
              in smaller steps, or lower maxInternalStep"
         ),
+        StepFailure::TurnTooFast { rate, limit, reach, dt } => format!(
+            "the holder's angular velocity changes by {rate:e} rad/s at the start of the step (anchorRX, anchorRY, anchorRZ): the \
+             sheet, reaching {reach:e} m from the pivot, would move relative to the holder by more than half the spacing per internal \
+             step of {dt:e} s (limit {limit:e} rad/s); turn the holder in smaller steps, or lower maxInternalStep"
+        ),
+        StepFailure::CoriolisNotConverged { .. } => format!("{cause}; lower maxInternalStep"),
         StepFailure::NewtonNotConverged { iterations, dt } => {
             format!("implicit Newmark: Newton did not converge in {iterations} iterations at dt = {dt:e} s; reduce maxInternalStep")
         }

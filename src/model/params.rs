@@ -50,6 +50,7 @@ impl Params {
             static_correction: self.scalar(vr::STATIC_CORRECTION) != 0.0,
             linearization: self.enumeration(vr::LINEARIZATION, Linearization::from_value),
             anchor_motion: self.scalar(vr::ANCHOR_MOTION) != 0.0,
+            anchor_rotation: self.scalar(vr::ANCHOR_ROTATION) != 0.0,
             force_evaluation: self.enumeration(vr::FORCE_EVALUATION, ForceEvaluation::from_value),
             cubature_tolerance: self.scalar(vr::CUBATURE_TOLERANCE),
             max_internal_step: self.scalar(vr::MAX_INTERNAL_STEP),
@@ -63,6 +64,7 @@ impl Params {
             point_load: [0.0; 3],
             load_node: None,
             anchor: [0.0; 3],
+            rotation: [0.0; 3],
             damping_alpha: 0.0,
             damping_beta: 0.0,
             mode_weights: Vec::new(),
@@ -79,6 +81,7 @@ impl Params {
         loads.point_load = [self.scalar(vr::LOAD_X), self.scalar(vr::LOAD_Y), self.scalar(vr::LOAD_Z)];
         loads.load_node = self.load_node();
         loads.anchor = [self.scalar(vr::ANCHOR_X), self.scalar(vr::ANCHOR_Y), self.scalar(vr::ANCHOR_Z)];
+        loads.rotation = [self.scalar(vr::ANCHOR_R_X), self.scalar(vr::ANCHOR_R_Y), self.scalar(vr::ANCHOR_R_Z)];
         loads.damping_alpha = self.scalar(vr::DAMPING_ALPHA);
         loads.damping_beta = self.scalar(vr::DAMPING_BETA);
         loads.mode_weights.clear();

@@ -1,6 +1,7 @@
 //! The simulator's part of a serialized FMU state (the payload's tail in
-//! [`crate::fmi::serialize`]): time, y, y', y'', the anchor and its rate,
-//! then the loads: gravity, point load, load node, anchor target, damping,
+//! [`crate::fmi::serialize`]): time, y, y', y'', the anchor and its rate, the holder's
+//! orientation and spin, then the loads: gravity, point load, load node,
+//! anchor and holder targets, damping,
 //! weights.
 
 use crate::fmi::serialize::{put_f64, put_f64s, put_u64, Reader};
@@ -12,12 +13,12 @@ pub fn write(snap: &Snapshot, p: &mut Vec<u8>) {
     put_f64s(p, &s.y);
     put_f64s(p, &s.v);
     put_f64s(p, &s.a);
-    s.anchor.iter().chain(&s.anchor_rate).for_each(|x| put_f64(p, *x));
+    s.anchor.iter().chain(&s.anchor_rate).chain(&s.rotation).chain(&s.spin).for_each(|x| put_f64(p, *x));
     let l = &snap.loads;
     l.gravity.iter().for_each(|g| put_f64(p, *g));
     l.point_load.iter().for_each(|f| put_f64(p, *f));
     put_u64(p, l.load_node.map_or(u64::MAX, |n| n as u64));
-    l.anchor.iter().for_each(|a| put_f64(p, *a));
+    l.anchor.iter().chain(&l.rotation).for_each(|a| put_f64(p, *a));
     put_f64(p, l.damping_alpha);
     put_f64(p, l.damping_beta);
     put_f64s(p, &l.mode_weights);
@@ -26,7 +27,8 @@ pub fn write(snap: &Snapshot, p: &mut Vec<u8>) {
 pub fn read(r: &mut Reader) -> Result<Snapshot, String> {
     let (time, y, v, a) = (r.f64()?, r.f64s()?, r.f64s()?, r.f64s()?);
     let (anchor, anchor_rate) = ([r.f64()?, r.f64()?, r.f64()?], [r.f64()?, r.f64()?, r.f64()?]);
-    let state = State { time, y, v, a, anchor, anchor_rate };
+    let (rotation, spin) = ([r.f64()?, r.f64()?, r.f64()?], [r.f64()?, r.f64()?, r.f64()?]);
+    let state = State { time, y, v, a, anchor, anchor_rate, rotation, spin };
     let gravity = [r.f64()?, r.f64()?, r.f64()?];
     let point_load = [r.f64()?, r.f64()?, r.f64()?];
     let load_node = match r.u64()? {
@@ -34,8 +36,9 @@ pub fn read(r: &mut Reader) -> Result<Snapshot, String> {
         n => Some(usize::try_from(n).map_err(|_| "load node out of range".to_string())?),
     };
     let anchor = [r.f64()?, r.f64()?, r.f64()?];
-    if !anchor.iter().all(|a| a.is_finite()) {
-        return Err("the anchor target holds non-finite values".into());
+    let rotation = [r.f64()?, r.f64()?, r.f64()?];
+    if !anchor.iter().chain(&rotation).all(|a| a.is_finite()) {
+        return Err("the anchor's or the holder's target holds non-finite values".into());
     }
     let damping_alpha = r.f64()?;
     let damping_beta = r.f64()?;
@@ -46,5 +49,5 @@ pub fn read(r: &mut Reader) -> Result<Snapshot, String> {
     if state.v.len() != state.y.len() || state.a.len() != state.y.len() {
         return Err(format!("the simulator state holds arrays of {}, {} and {} values", state.y.len(), state.v.len(), state.a.len()));
     }
-    Ok(Snapshot { state, loads: Loads { gravity, point_load, load_node, anchor, damping_alpha, damping_beta, mode_weights } })
+    Ok(Snapshot { state, loads: Loads { gravity, point_load, load_node, anchor, rotation, damping_alpha, damping_beta, mode_weights } })
 }

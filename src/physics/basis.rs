@@ -27,6 +27,7 @@ use faer::{Accum, Col, Mat, MatMut, MatRef, Par, Side};
 use super::equilibrium::equilibrium;
 use super::error::PhysicsError;
 use super::forces::StiffnessPattern;
+use super::frame::cross;
 use super::modes::ModalBasis;
 use super::scene::Scene;
 use super::settings::{Linearization, ModeSelection, Settings};
@@ -58,8 +59,11 @@ pub struct Basis {
 /// is not zero, and the point load on its node, when it is not zero
 /// (`docs/method.md`, section 8). With `anchor_motion` the inertial load of
 /// an anchor acceleration along each axis, M e_i, takes the place of M g
-/// (whose span it holds).
-pub fn load_patterns(scene: &Scene, loads: &Loads, anchor_motion: bool) -> Vec<Vec<f64>> {
+/// (whose span it holds). With `anchor_rotation` the inertial loads of the
+/// holder's angular acceleration and of its spin about each axis it can
+/// turn about (z alone in 2D) join them: M (e_i x s) and M (s - e_i (e_i . s)),
+/// s = x_rest - X0 about the pivot.
+pub fn load_patterns(scene: &Scene, loads: &Loads, anchor_motion: bool, anchor_rotation: bool) -> Vec<Vec<f64>> {
     let d = scene.dim;
     let g = &loads.gravity[..d];
     let mut patterns = Vec::new();
@@ -74,6 +78,25 @@ pub fn load_patterns(scene: &Scene, loads: &Loads, anchor_motion: bool) -> Vec<V
         let mut p = vec![0.0; scene.n_dofs()];
         p[dof..dof + d].copy_from_slice(f);
         patterns.push(p);
+    }
+    if anchor_rotation {
+        let pivot = scene.pivot();
+        let axes: &[usize] = if d == 2 { &[2] } else { &[0, 1, 2] };
+        for &axis in axes {
+            let e: [f64; 3] = std::array::from_fn(|i| if i == axis { 1.0 } else { 0.0 });
+            let (mut euler, mut spin) = (vec![0.0; scene.n_dofs()], vec![0.0; scene.n_dofs()]);
+            for k in 0..scene.n_free {
+                let s: [f64; 3] = std::array::from_fn(|i| if i < d { scene.rest[k * d + i] - pivot[i] } else { 0.0 });
+                let turned = cross(&e, &s);
+                for i in 0..d {
+                    let m = scene.dof_mass[k * d + i];
+                    euler[k * d + i] = m * turned[i];
+                    spin[k * d + i] = m * (s[i] - e[i] * s[axis]);
+                }
+            }
+            patterns.push(euler);
+            patterns.push(spin);
+        }
     }
     patterns
 }
@@ -106,7 +129,7 @@ pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) 
     let mut stiffness = vec![0.0; pattern.nnz()];
     pattern.add_tangent(scene, &point, 1.0, &mut stiffness);
     let at_rest = settings.linearization == Linearization::Rest;
-    let patterns = load_patterns(scene, loads, settings.anchor_motion);
+    let patterns = load_patterns(scene, loads, settings.anchor_motion, settings.anchor_rotation);
     let needs_load = settings.mode_selection == ModeSelection::Load || settings.static_correction;
     if needs_load && patterns.is_empty() {
         return Err(PhysicsError::NoLoad);
@@ -137,10 +160,13 @@ pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) 
             } else {
                 // At the equilibrium the sag is known exactly: the displacement from rest.
                 vectors.push((0..n).map(|k| point[k] - scene.rest[k]).collect());
-                if settings.anchor_motion {
-                    // The anchor's inertial loads act around the equilibrium, through its tangent stiffness.
+                if settings.anchor_motion || settings.anchor_rotation {
+                    // The holder's inertial loads act around the equilibrium, through its tangent stiffness.
                     let solver = ShiftedStiffness::new(scene, &pattern, &stiffness)?;
-                    vectors.extend(patterns.iter().take(scene.dim).map(|f| solver.solve(f)));
+                    let translation = if settings.anchor_motion { scene.dim } else { 0 };
+                    let rotation = if settings.anchor_rotation { 2 * if scene.dim == 2 { 1 } else { 3 } } else { 0 };
+                    let inertial = patterns[..translation].iter().chain(&patterns[patterns.len() - rotation..]);
+                    vectors.extend(inertial.map(|f| solver.solve(f)));
                 }
             }
             vectors.extend((eigen..candidates.r).map(|j| columns(&candidates, j)));

@@ -11,7 +11,7 @@ use std::marker::PhantomData;
 
 use super::bake::SetupData;
 use super::error::{PhysicsError, StepFailure};
-use super::frame::Moments;
+use super::frame::{Frame, Moments};
 use super::integrator::{Buffers, NewmarkExplicit, NewmarkImplicit, Scheme, Trigonometric};
 use super::scene::Scene;
 use super::settings::{ForceEvaluation, Integrator, Reduction, Settings};
@@ -84,10 +84,16 @@ pub trait Stepper: Probe + Send {
     /// After the internal steps of a communication step: the forces
     /// evaluated at `state.y` (see [`Scheme::finish`]).
     fn finish(&mut self, loads: &Loads, state: &State);
-    /// Adds the rates of a rigid translation with velocity `c` to
-    /// `state.v` (see [`Space::add_translation_rate`]) and sets `state.a`
-    /// for the new rates (see [`Scheme::settle_rates`]).
-    fn translate_rates(&mut self, loads: &Loads, c: &[f64; 3], state: &mut State);
+    /// Adds the rates of a rigid translation with velocity `c` and of a
+    /// rigid rotation about the pivot with angular velocity `spin` to
+    /// `state.v` (see [`Space::add_translation_rate`],
+    /// [`Space::add_rotation_rate`]) and sets `state.a` for the new rates
+    /// (see [`Scheme::settle_rates`]).
+    fn kick(&mut self, loads: &Loads, c: &[f64; 3], spin: &[f64; 3], state: &mut State);
+    /// The holder's frame for what follows (see [`Space::turn`]).
+    fn turn(&mut self, loads: &Loads, frame: &Frame);
+    /// The scheme can integrate a turning holder (see [`Scheme::TURNS`]).
+    fn turns(&self) -> bool;
 }
 
 /// What the simulator reads from a bound space at a state: the outputs,
@@ -98,6 +104,8 @@ pub trait Probe {
     fn spring_force(&mut self, loads: &Loads, state: &State, y: &[f64], out: &mut [f64]);
     /// Momentum of the free nodes per axis, relative to the anchor [kg m/s].
     fn momentum(&self, state: &State) -> [f64; 3];
+    /// The mass moments of the rates at `state` (see [`Readout::moments`]).
+    fn motion(&self, state: &State) -> Moments;
     /// Kinetic energy of `state` [J].
     fn kinetic_energy(&self, state: &State) -> f64;
     /// Potential energy of `state` as the force model sums it (see
@@ -118,14 +126,16 @@ pub trait Probe {
     /// First mass moment of the free nodes about the pivot at `state.y`
     /// (see [`Readout::first_moment`]) [kg m].
     fn first_moment(&self, state: &State) -> [f64; 3];
-    /// sum M z over the free nodes per axis, z = y'' + M^-1 C y' of the
-    /// motion the scheme integrates at `state` (whose forces were evaluated
-    /// last; see [`Scheme::acceleration`]): what the free nodes' forces
-    /// other than damping sum to, with the damping's share [N].
-    fn driven_momentum(&mut self, state: &State) -> [f64; 3];
-    /// The mass moments at `state`: of the rates, and of z as above
+    /// The rate of change of the free nodes' momentum relative to the
+    /// holder, sum M y'' per axis, with y'' of the motion the scheme
+    /// integrates at `state` (whose forces were evaluated last; see
+    /// [`Scheme::acceleration`]) [N].
+    fn momentum_rate(&mut self, state: &State) -> [f64; 3];
+    /// The mass moments at `state`: of the rates, and of y'' as above
     /// (see [`Readout::moments`]).
     fn moments(&mut self, state: &State) -> (Moments, Moments);
+    /// Elastic energy of every spring at `state` (whose forces were evaluated last) [J].
+    fn elastic_energy(&mut self, state: &State) -> f64;
     /// Elastic energy of every spring plus gravity potential at `state` [J].
     fn potential_energy(&mut self, loads: &Loads, state: &State) -> f64;
     /// The force the space cannot represent at `state`, relative to the load.
@@ -139,6 +149,8 @@ pub struct Outputs {
     pub positions: Vec<f64>,
     /// Node velocities, same layout [m/s].
     pub velocities: Vec<f64>,
+    /// Node positions in the holder's frame, while it has turned [m].
+    pub frame_positions: Vec<f64>,
     /// Velocities of the free DOFs.
     pub dof_velocities: Vec<f64>,
     /// Coordinates of the kept or reported modes.
@@ -162,6 +174,7 @@ impl Outputs {
         Outputs {
             positions: vec![0.0; nodes],
             velocities: vec![0.0; nodes],
+            frame_positions: vec![0.0; nodes],
             dof_velocities: vec![0.0; scene.n_dofs()],
             modal_coordinates: vec![0.0; modes],
             kinetic: 0.0,
@@ -178,9 +191,8 @@ pub struct Engine<S: Readout, I: Scheme> {
     space: S,
     work: S::Work,
     buffers: Buffers,
-    /// y'' of the scheme's motion and z = y'' + M^-1 C y', for the holder's force and torque.
+    /// y'' of the scheme's motion, for the holder's force and torque.
     acceleration: Vec<f64>,
-    driven: Vec<f64>,
     scheme: PhantomData<I>,
 }
 
@@ -190,13 +202,12 @@ impl<S: Readout, I: Scheme> Engine<S, I> {
         let work = space.work();
         I::check(&space, &work)?;
         let n = space.layout().coordinates;
-        Ok(Engine { work, buffers: Buffers::new(n, I::SCRATCH), acceleration: vec![0.0; n], driven: vec![0.0; n], space, scheme: PhantomData })
+        Ok(Engine { work, buffers: Buffers::new(n, I::SCRATCH), acceleration: vec![0.0; n], space, scheme: PhantomData })
     }
 
-    /// z = y'' + M^-1 C y' of the scheme's motion at `state` into `self.driven`.
-    fn drive(&mut self, state: &State) {
+    /// y'' of the scheme's motion at `state` into `self.acceleration`.
+    fn accelerate(&mut self, state: &State) {
         I::acceleration(&self.space, &mut self.work, &mut self.buffers, state, &mut self.acceleration);
-        self.space.undamped_acceleration(&state.v, &self.acceleration, &mut self.work, &mut self.driven);
     }
 }
 
@@ -247,9 +258,22 @@ impl<S: Readout, I: Scheme> Stepper for Engine<S, I> {
         I::finish(&self.space, &mut self.work, &mut self.buffers, loads, state);
     }
 
-    fn translate_rates(&mut self, loads: &Loads, c: &[f64; 3], state: &mut State) {
-        self.space.add_translation_rate(loads, c, &mut state.v);
+    fn kick(&mut self, loads: &Loads, c: &[f64; 3], spin: &[f64; 3], state: &mut State) {
+        if *c != [0.0; 3] {
+            self.space.add_translation_rate(loads, c, &mut state.v);
+        }
+        if *spin != [0.0; 3] {
+            self.space.add_rotation_rate(loads, spin, &state.y, &mut state.v);
+        }
         I::settle_rates(&self.space, &mut self.work, &mut self.buffers, loads, state);
+    }
+
+    fn turn(&mut self, loads: &Loads, frame: &Frame) {
+        self.space.turn(loads, frame, &mut self.work);
+    }
+
+    fn turns(&self) -> bool {
+        I::TURNS
     }
 }
 
@@ -261,6 +285,10 @@ impl<S: Readout, I: Scheme> Probe for Engine<S, I> {
 
     fn momentum(&self, state: &State) -> [f64; 3] {
         self.space.momentum(&state.v)
+    }
+
+    fn motion(&self, state: &State) -> Moments {
+        self.space.moments(&state.y, &state.v)
     }
 
     fn kinetic_energy(&self, state: &State) -> f64 {
@@ -311,14 +339,18 @@ impl<S: Readout, I: Scheme> Probe for Engine<S, I> {
         self.space.first_moment(&state.y)
     }
 
-    fn driven_momentum(&mut self, state: &State) -> [f64; 3] {
-        self.drive(state);
-        self.space.momentum(&self.driven)
+    fn momentum_rate(&mut self, state: &State) -> [f64; 3] {
+        self.accelerate(state);
+        self.space.momentum(&self.acceleration)
     }
 
     fn moments(&mut self, state: &State) -> (Moments, Moments) {
-        self.drive(state);
-        (self.space.moments(&state.y, &state.v), self.space.moments(&state.y, &self.driven))
+        self.accelerate(state);
+        (self.space.moments(&state.y, &state.v), self.space.moments(&state.y, &self.acceleration))
+    }
+
+    fn elastic_energy(&mut self, state: &State) -> f64 {
+        self.space.elastic_energy(&state.y, &mut self.work)
     }
 
     fn potential_energy(&mut self, loads: &Loads, state: &State) -> f64 {

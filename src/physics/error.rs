@@ -34,6 +34,8 @@ pub enum Quantity {
     /// The force on the load node [N].
     PointLoad,
     Anchor,
+    /// The holder's rotation vector [rad].
+    Rotation,
     /// Mass-proportional Rayleigh damping alpha [1/s].
     DampingAlpha,
     /// Stiffness-proportional Rayleigh damping beta [s].
@@ -62,6 +64,7 @@ impl Quantity {
             Quantity::Gravity => "gravity",
             Quantity::PointLoad => "point load",
             Quantity::Anchor => "anchor displacement",
+            Quantity::Rotation => "holder rotation",
             Quantity::DampingAlpha => "mass-proportional damping",
             Quantity::DampingBeta => "stiffness-proportional damping",
             Quantity::ModeWeights => "mode weights",
@@ -92,6 +95,9 @@ pub enum Expected {
     /// Above 0 and at most this value.
     #[error("above 0 and at most {0}")]
     PositiveAtMost(f64),
+    /// At most this value in magnitude.
+    #[error("finite and at most {0} in magnitude")]
+    Within(f64),
 }
 
 /// Why an internal step failed. The state is that of the start of the
@@ -126,6 +132,16 @@ pub enum StepFailure {
     /// one internal step of `dt` (`docs/method.md`, section 8).
     #[error("the anchor's velocity changes by {speed:e} m/s at the start of the step: the sheet would move relative to it by more than half the spacing per internal step of {dt:e} s (limit {limit:e} m/s); move the anchor more smoothly")]
     AnchorTooFast { speed: f64, limit: f64, dt: f64 },
+    /// The holder's angular velocity changes by `rate` at the start of the
+    /// step: the sheet's far end, `reach` from the pivot, would move
+    /// relative to the holder by more than half the spacing in one internal step of `dt`.
+    #[error("the holder's angular velocity changes by {rate:e} rad/s at the start of the step: the sheet, reaching {reach:e} m from the pivot, would move relative to the holder by more than half the spacing per internal step of {dt:e} s (limit {limit:e} rad/s); turn the holder more smoothly")]
+    TurnTooFast { rate: f64, limit: f64, reach: f64, dt: f64 },
+    /// The explicit velocity update of a full-space step under a turning
+    /// holder with stiffness-proportional damping did not converge (the
+    /// holder turns by more than a radian per internal step).
+    #[error("the velocity update with the Coriolis force did not converge at dt = {dt:e} s (the holder turns by {turn:e} rad per internal step); shorten the internal steps")]
+    CoriolisNotConverged { turn: f64, dt: f64 },
 }
 
 /// An error of the physics core.
@@ -228,6 +244,10 @@ pub enum PhysicsError {
     /// space); the full space's stiffness and damping couple its coordinates.
     #[error("the {} integrator integrates the linear oscillator of every mode exactly and needs the modal space; in full space the stiffness and the damping couple the coordinates", .scheme.name())]
     SchemeNeedsDiagonal { scheme: Integrator },
+    /// The scheme integrates forces of the positions alone and cannot take
+    /// the Coriolis force of a turning holder.
+    #[error("the {} scheme integrates forces of the positions alone; a turning holder adds the Coriolis force, which depends on the rates", .scheme.name())]
+    SchemeCannotTurn { scheme: Integrator },
     /// A snapshot whose arrays do not fit this simulator.
     #[error("the snapshot holds {len} state values, this simulator needs {expected}")]
     SnapshotLength { len: usize, expected: usize },

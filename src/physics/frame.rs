@@ -66,3 +66,66 @@ pub fn add_outer(t: &mut [f64; 9], s: f64, u: &[f64; 3], w: &[f64; 3]) {
         }
     }
 }
+
+/// The holder's frame as the equations in it need it at one instant:
+/// gravity and the point load turned into it, R^T g and R^T f_p, and its
+/// angular velocity Omega in its own axes (constant over a communication step).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Frame {
+    pub gravity: [f64; 3],
+    pub load: [f64; 3],
+    pub spin: [f64; 3],
+}
+
+/// R(theta), row-major: the rotation by |theta| about theta / |theta| (Rodrigues; the identity at 0).
+pub fn rotation(theta: &[f64; 3]) -> [f64; 9] {
+    if *theta == [0.0; 3] {
+        return IDENTITY;
+    }
+    let r = nalgebra::Rotation3::from_scaled_axis(nalgebra::Vector3::from(*theta));
+    let m = r.matrix();
+    std::array::from_fn(|k| m[(k / 3, k % 3)])
+}
+
+/// The 3 x 3 identity, row-major.
+pub const IDENTITY: [f64; 9] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+
+/// R^T b.
+#[inline]
+pub fn apply_transposed(r: &[f64; 9], b: &[f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| r[i] * b[0] + r[3 + i] * b[1] + r[6 + i] * b[2])
+}
+
+/// A B.
+pub fn compose(a: &[f64; 9], b: &[f64; 9]) -> [f64; 9] {
+    std::array::from_fn(|k| {
+        let (i, j) = (k / 3, k % 3);
+        a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] + a[3 * i + 2] * b[6 + j]
+    })
+}
+
+/// The holder's angular velocity in its own axes over a step of `h` from
+/// orientation R(theta0) to R(theta1), constant over the step: Omega with
+/// R(theta0) exp(h [Omega]x) = R(theta1). About a fixed axis (theta0 and
+/// theta1 parallel, always in 2D) it is (theta1 - theta0) / h, so a turn of
+/// more than half a revolution in one step keeps its sense and size;
+/// otherwise the rotation vector of R(theta0)^T R(theta1), at most pi / h.
+pub fn spin(theta0: &[f64; 3], theta1: &[f64; 3], h: f64) -> [f64; 3] {
+    if cross(theta0, theta1) == [0.0; 3] {
+        return std::array::from_fn(|i| (theta1[i] - theta0[i]) / h);
+    }
+    let (r0, r1) = (rotation(theta0), rotation(theta1));
+    let m: [f64; 9] = std::array::from_fn(|k| {
+        let (i, j) = (k / 3, k % 3);
+        r0[i] * r1[j] + r0[3 + i] * r1[3 + j] + r0[6 + i] * r1[6 + j]
+    });
+    let rel = nalgebra::Rotation3::from_matrix_unchecked(nalgebra::Matrix3::from_row_slice(&m));
+    let w = rel.scaled_axis();
+    [w[0] / h, w[1] / h, w[2] / h]
+}
+
+/// |v|.
+#[inline]
+pub fn norm(v: &[f64; 3]) -> f64 {
+    dot(v, v).sqrt()
+}

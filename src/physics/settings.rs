@@ -27,6 +27,11 @@ pub struct Settings {
     /// The anchor will move: its inertial load along each axis, M e_i, is
     /// a load pattern of the basis and the cubature's training (`docs/method.md`, section 8).
     pub anchor_motion: bool,
+    /// The holder will turn: the inertial loads of its angular
+    /// acceleration and of its spin about each axis it can turn about
+    /// (M (e_i x s) and M s_perp,i, s the rest positions about the pivot) are
+    /// load patterns of the basis (`docs/method.md`, section 8).
+    pub anchor_rotation: bool,
     /// How the modal space evaluates the projected spring force: every
     /// spring (the paper's) or a trained cubature (`docs/method.md`, section 4).
     pub force_evaluation: ForceEvaluation,
@@ -53,6 +58,7 @@ impl Settings {
             static_correction: false,
             linearization: Linearization::Rest,
             anchor_motion: false,
+            anchor_rotation: false,
             force_evaluation: ForceEvaluation::Exact,
             cubature_tolerance: 0.01,
             max_internal_step: 0.01,

@@ -14,7 +14,7 @@
 use super::bake::SetupData;
 use super::engine::{self, Outputs, Stepper};
 use super::error::{positive, Expected, PhysicsError, Quantity, StepFailure};
-use super::frame::cross;
+use super::frame::{self, apply, apply_transposed, compose, cross, dot, norm, rotation, Frame};
 use super::scene::Scene;
 use super::settings::{Reduction, Settings};
 use super::state::{Loads, Snapshot, State};
@@ -78,6 +78,13 @@ pub struct Simulator {
     reach: f64,
     /// Shortest spring at rest (the grid spacing) [m], for the anchor's speed limit.
     spacing: f64,
+    /// The pivot X0, how far from it the sheet can reach, and sum m (x_rest - X0).
+    pivot: [f64; 3],
+    arm: f64,
+    rest_moment: [f64; 3],
+    /// The loads with gravity and the point load turned into the holder's
+    /// frame at the state's time, while it has turned.
+    local: Loads,
 }
 
 impl Simulator {
@@ -102,12 +109,27 @@ impl Simulator {
         let (free_mass, reach) = (scene.free_mass(), scene.reach());
         let spacing = scene.springs.iter().map(|s| s.rest).filter(|&l| l > 0.0).fold(f64::INFINITY, f64::min);
         let dim = scene.dim;
+        let pivot = scene.pivot();
+        let slots = scene.rest.chunks_exact(dim);
+        let arm = slots.clone().map(|x| (0..dim).map(|i| (x[i] - pivot[i]).powi(2)).sum::<f64>().sqrt()).fold(0.0, f64::max) + reach;
+        let mut rest_moment = [0.0; 3];
+        for (k, x) in slots.take(scene.n_free).enumerate() {
+            for i in 0..dim {
+                rest_moment[i] += scene.dof_mass[k * dim] * (x[i] - pivot[i]);
+            }
+        }
         let mut engine = engine::build(scene, settings, loads, prebuilt)?;
         engine.apply_loads(loads);
         let mut state = State::at_rest(engine.layout().coordinates);
         engine.rest_coordinates(&mut state.y);
-        // The sheet starts at rest wherever the anchor is.
+        // The sheet starts at rest wherever the anchor is and however the holder is turned.
         state.anchor[..dim].copy_from_slice(&loads.anchor[..dim]);
+        state.rotation = planar(&loads.rotation, dim);
+        let mut local = loads.clone();
+        turn_loads(&mut local, loads, &rotation(&state.rotation), dim);
+        if state.rotation != [0.0; 3] {
+            engine.turn(loads, &Frame { gravity: local.gravity, load: local.point_load, spin: [0.0; 3] });
+        }
         engine.settle(loads, &mut state);
         let mut sim = Simulator {
             outputs: Outputs::new(engine.scene(), settings.n_modes),
@@ -122,6 +144,10 @@ impl Simulator {
             free_mass,
             reach,
             spacing,
+            pivot,
+            arm,
+            rest_moment,
+            local,
         };
         sim.check_stable_step_cost()?;
         sim.refresh_outputs();
@@ -185,14 +211,37 @@ impl Simulator {
             let cause = StepFailure::AnchorTooFast { speed: kick_speed, limit: 0.5 * self.spacing / dt, dt };
             return Err(PhysicsError::StepFailed { time: self.state.time, cause });
         }
+        // The holder turns at a constant rate to its target over the step:
+        // its spin changes by -turn now, and the free nodes get turn x rho relative to it.
+        let target = planar(&self.loads.rotation, d);
+        let spin = frame::spin(&self.state.rotation, &target, h);
+        let turn: [f64; 3] = std::array::from_fn(|i| self.state.spin[i] - spin[i]);
+        let turning = self.turned() || spin != [0.0; 3];
+        if (spin != [0.0; 3] || self.state.spin != [0.0; 3]) && !self.engine.turns() {
+            return Err(PhysicsError::SchemeCannotTurn { scheme: self.settings.integrator });
+        }
+        let turn_rate = norm(&turn);
+        if !turn_rate.is_finite() || turn_rate * self.arm * dt > 0.5 * self.spacing {
+            let cause = StepFailure::TurnTooFast { rate: turn_rate, limit: 0.5 * self.spacing / (self.arm * dt), reach: self.arm, dt };
+            return Err(PhysicsError::StepFailed { time: self.state.time, cause });
+        }
         self.backup.copy_from(&self.state);
-        if kick_speed > 0.0 {
-            self.engine.translate_rates(&self.loads, &kick, &mut self.state);
+        let start = rotation(&self.state.rotation);
+        if turning {
+            self.engine.turn(&self.loads, &self.frame(&start, 0.0, &spin));
+            kick = apply_transposed(&start, &kick);
+        }
+        if kick_speed > 0.0 || turn_rate > 0.0 {
+            self.engine.kick(&self.loads, &kick, &turn, &mut self.state);
             // The kick's kinetic energy is supplied, not grown.
-            energy_before += self.free_mass * kick_speed * kick_speed * self.loads.weight_max().powi(2);
+            energy_before += self.free_mass * (kick_speed + turn_rate * self.arm).powi(2) * self.loads.weight_max().powi(2);
         }
         let mut result = Ok(());
-        for _ in 0..steps {
+        for i in 0..steps {
+            if spin != [0.0; 3] {
+                // Gravity and the point load turn in the holder's frame: as they are at the step's end.
+                self.engine.turn(&self.loads, &self.frame(&start, (i + 1) as f64 * dt, &spin));
+            }
             result = self.engine.step(&self.loads, &mut self.state, dt);
             if result.is_err() {
                 break;
@@ -201,8 +250,16 @@ impl Simulator {
         if result.is_ok() {
             self.engine.finish(&self.loads, &self.state);
         }
-        if let Err(cause) = result.and_then(|_| self.check_state(dt, energy_before)) {
+        // A spinning frame can give the sheet the kinetic energy of its far end at the frame's speed.
+        let spun = self.free_mass * (norm(&spin) * self.arm).powi(2) * self.loads.weight_max().powi(2);
+        if let Err(cause) = result.and_then(|_| self.check_state(dt, energy_before + spun)) {
             self.state.copy_from(&self.backup);
+            if turning {
+                self.engine.apply_loads(&self.loads);
+                if self.turned() {
+                    self.engine.turn(&self.loads, &self.frame(&start, 0.0, &self.state.spin));
+                }
+            }
             self.engine.evaluate(&self.loads, &self.state);
             return Err(PhysicsError::StepFailed { time: self.state.time, cause });
         }
@@ -210,8 +267,36 @@ impl Simulator {
         self.state.time += h;
         self.state.anchor[..d].copy_from_slice(&self.loads.anchor[..d]);
         self.state.anchor_rate = rate;
+        if turning {
+            self.state.rotation = target;
+            self.state.spin = spin;
+            turn_loads(&mut self.local, &self.loads, &rotation(&target), d);
+        }
         self.refresh_outputs();
         Ok(())
+    }
+
+    /// The loads' terms of the space, in the holder's frame once it has turned.
+    fn apply_loads(&mut self) {
+        self.engine.apply_loads(&self.loads);
+        if self.turned() {
+            let d = self.scene().dim;
+            turn_loads(&mut self.local, &self.loads, &rotation(&self.state.rotation), d);
+            let frame = Frame { gravity: self.local.gravity, load: self.local.point_load, spin: self.state.spin };
+            self.engine.turn(&self.loads, &frame);
+        }
+    }
+
+    /// The holder has left its rest orientation or turns.
+    fn turned(&self) -> bool {
+        self.state.rotation != [0.0; 3] || self.state.spin != [0.0; 3]
+    }
+
+    /// The holder's frame `tau` after the orientation `start`, turning at `spin`.
+    fn frame(&self, start: &[f64; 9], tau: f64, spin: &[f64; 3]) -> Frame {
+        let r = if tau == 0.0 || *spin == [0.0; 3] { *start } else { compose(start, &rotation(&spin.map(|w| w * tau))) };
+        let d = self.scene().dim;
+        Frame { gravity: into_frame(&r, &self.loads.gravity, d), load: into_frame(&r, &self.loads.point_load, d), spin: *spin }
     }
 
     /// Rejects non-finite states and kinetic energy that grew far beyond
@@ -238,7 +323,16 @@ impl Simulator {
         let relative = self.engine.kinetic_energy(&self.state);
         // In the ground's frame: 1/2 (v + c)^T M (v + c), c the anchor's velocity.
         let c = self.state.anchor_rate;
-        self.outputs.kinetic = if c == [0.0; 3] {
+        self.outputs.kinetic = if self.turned() {
+            // 1/2 sum m |c + R (v + w x rho)|^2 = 1/2 sum m |v|^2 + w . L + 1/2 (|w|^2 tr J - w^T J w)
+            //   + c . R (P + w x S) + 1/2 m |c|^2, with the moments of the rates.
+            let (r, w, m) = (rotation(&self.state.rotation), self.state.spin, self.engine.motion(&self.state));
+            let j = &m.second;
+            let inner = relative + dot(&w, &m.angular()) + 0.5 * (dot(&w, &w) * (j[0] + j[4] + j[8]) - dot(&w, &apply(j, &w)));
+            let sw = cross(&w, &m.first);
+            let frame = apply(&r, &std::array::from_fn(|i| m.momentum[i] + sw[i]));
+            inner + dot(&c, &frame) + 0.5 * self.free_mass * dot(&c, &c)
+        } else if c == [0.0; 3] {
             relative
         } else {
             let p = self.engine.momentum(&self.state);
@@ -266,7 +360,16 @@ impl Simulator {
     pub fn positions(&mut self) -> &[f64] {
         if !self.fresh.positions {
             self.engine.node_positions(&self.state, &mut self.outputs);
-            shift(&mut self.outputs.positions, &self.state.anchor, self.engine.scene().dim);
+            if self.turned() {
+                self.outputs.frame_positions.copy_from_slice(&self.outputs.positions);
+                let (r, d, a) = (rotation(&self.state.rotation), self.scene().dim, self.state.anchor);
+                for x in self.outputs.positions.chunks_exact_mut(d) {
+                    let p = place(&self.pivot, &a, &r, x);
+                    x.copy_from_slice(&p[..d]);
+                }
+            } else {
+                shift(&mut self.outputs.positions, &self.state.anchor, self.engine.scene().dim);
+            }
             self.fresh.positions = true;
         }
         &self.outputs.positions
@@ -275,7 +378,17 @@ impl Simulator {
     pub fn velocities(&mut self) -> &[f64] {
         if !self.fresh.velocities {
             self.engine.node_velocities(&self.state, &mut self.outputs);
-            shift(&mut self.outputs.velocities, &self.state.anchor_rate, self.engine.scene().dim);
+            if self.turned() {
+                self.positions();
+                let (r, d) = (rotation(&self.state.rotation), self.scene().dim);
+                let (c, w) = (self.state.anchor_rate, self.state.spin);
+                for (v, x) in self.outputs.velocities.chunks_exact_mut(d).zip(self.outputs.frame_positions.chunks_exact(d)) {
+                    let u = ground_velocity(&self.pivot, &c, &w, &r, v, x);
+                    v.copy_from_slice(&u[..d]);
+                }
+            } else {
+                shift(&mut self.outputs.velocities, &self.state.anchor_rate, self.engine.scene().dim);
+            }
             self.fresh.velocities = true;
         }
         &self.outputs.velocities
@@ -289,6 +402,9 @@ impl Simulator {
             return Some(std::array::from_fn(|i| if i < d { self.outputs.positions[node * d + i] } else { 0.0 }));
         }
         let x = self.engine.node_position(&self.state, node);
+        if self.turned() {
+            return Some(place(&self.pivot, &self.state.anchor, &rotation(&self.state.rotation), &x[..d]));
+        }
         Some(std::array::from_fn(|i| if i < d { x[i] + self.state.anchor[i] } else { 0.0 }))
     }
     /// Velocity of the load node (z 0 in 2D), if the node is in the scene [m/s].
@@ -298,47 +414,72 @@ impl Simulator {
             return Some(std::array::from_fn(|i| if i < d { self.outputs.velocities[node * d + i] } else { 0.0 }));
         }
         let v = self.engine.node_velocity(&self.state, node);
+        if self.turned() {
+            let x = self.engine.node_position(&self.state, node);
+            let (c, w) = (self.state.anchor_rate, self.state.spin);
+            return Some(ground_velocity(&self.pivot, &c, &w, &rotation(&self.state.rotation), &v[..d], &x[..d]));
+        }
         Some(std::array::from_fn(|i| if i < d { v[i] + self.state.anchor_rate[i] } else { 0.0 }))
     }
     /// The force the sheet exerts on its holder, from the momentum balance
     /// of the free nodes (`docs/method.md`, section 8):
-    /// F = m_free g + f_p - sum M z, z = y'' + M^-1 C y' of the motion the
-    /// scheme integrates, so the damping's reaction is the holder's and, in
-    /// 3D, so is what the auxiliary springs carry (their points ride with
-    /// the holder). O(r) in the modal space; z is 0 in 2D [N].
+    /// F = m_free g + f_p - sum M y'', y'' of the motion the scheme
+    /// integrates, so the damping's reaction (it acts on the motion
+    /// relative to the holder) is the holder's and, in 3D, so is what the
+    /// auxiliary springs carry (their points ride with the holder). O(r) in
+    /// the modal space; z is 0 in 2D [N].
     pub fn anchor_force(&mut self) -> [f64; 3] {
         if !self.fresh.anchor {
-            let driven = self.engine.driven_momentum(&self.state);
-            let (d, g, f) = (self.scene().dim, self.loads.gravity, self.point_load());
-            self.outputs.anchor_force = std::array::from_fn(|i| if i < d { self.free_mass * g[i] + f[i] - driven[i] } else { 0.0 });
+            let driven = self.engine.momentum_rate(&self.state);
+            let turned = self.turned();
+            let loads = if turned { &self.local } else { &self.loads };
+            let (d, g, f) = (self.scene().dim, loads.gravity, point_load(loads, self.scene()));
+            let mut force: [f64; 3] = std::array::from_fn(|i| if i < d { self.free_mass * g[i] + f[i] - driven[i] } else { 0.0 });
+            if turned {
+                // In the holder's frame, less the Coriolis and centrifugal parts of dP/dt: 2 w x P + w x (w x S).
+                let (w, p, s) = (self.state.spin, self.engine.momentum(&self.state), self.engine.first_moment(&self.state));
+                let (coriolis, centrifugal) = (cross(&w, &p), cross(&w, &cross(&w, &s)));
+                let local: [f64; 3] = std::array::from_fn(|i| force[i] - 2.0 * coriolis[i] - centrifugal[i]);
+                force = apply(&rotation(&self.state.rotation), &local);
+            }
+            self.outputs.anchor_force = force;
             self.fresh.anchor = true;
         }
         self.outputs.anchor_force
     }
     /// The torque the sheet exerts on its holder about the pivot, from the
     /// balance of angular momentum (`docs/method.md`, section 8):
-    /// S x g + rho_p x f_p - sum m rho x z; only z in 2D. O(r^2) in the modal space [N m].
+    /// S x g + rho_p x f_p - sum m rho x y'', less, while the holder turns at w,
+    /// 2 (w tr N - N w) - w x (J w); only z in 2D. O(r^2) in the modal space [N m].
     pub fn anchor_torque(&mut self) -> [f64; 3] {
         if !self.fresh.torque {
-            let (_, driven) = self.engine.moments(&self.state);
+            let (motion, driven) = self.engine.moments(&self.state);
+            let turned = self.turned();
+            let loads = if turned { &self.local } else { &self.loads };
             let d = self.scene().dim;
-            let g: [f64; 3] = std::array::from_fn(|i| if i < d { self.loads.gravity[i] } else { 0.0 });
+            let g: [f64; 3] = std::array::from_fn(|i| if i < d { loads.gravity[i] } else { 0.0 });
             let mut t = cross(&driven.first, &g);
-            let f = self.point_load();
-            if let Some(node) = self.loads.load_node.filter(|_| f != [0.0; 3]) {
-                let (x, pivot) = (self.engine.node_position(&self.state, node), self.scene().pivot());
-                let arm = cross(&std::array::from_fn(|i| x[i] - pivot[i]), &f);
+            let f = point_load(loads, self.scene());
+            if let Some(node) = loads.load_node.filter(|_| f != [0.0; 3]) {
+                let x = self.engine.node_position(&self.state, node);
+                let arm = cross(&std::array::from_fn(|i| x[i] - self.pivot[i]), &f);
                 t = std::array::from_fn(|i| t[i] + arm[i]);
             }
             let inertial = driven.angular();
-            self.outputs.anchor_torque = std::array::from_fn(|i| if d == 3 || i == 2 { t[i] - inertial[i] } else { 0.0 });
+            t = std::array::from_fn(|i| t[i] - inertial[i]);
+            if turned {
+                let w = self.state.spin;
+                let n = &motion.flux;
+                let (nw, jw) = (apply(n, &w), apply(&motion.second, &w));
+                let gyro = cross(&w, &jw);
+                let trace = n[0] + n[4] + n[8];
+                t = std::array::from_fn(|i| t[i] - 2.0 * (w[i] * trace - nw[i]) + gyro[i]);
+                t = apply(&rotation(&self.state.rotation), &t);
+            }
+            self.outputs.anchor_torque = std::array::from_fn(|i| if d == 3 || i == 2 { t[i] } else { 0.0 });
             self.fresh.torque = true;
         }
         self.outputs.anchor_torque
-    }
-    /// The point load where it acts, on a free load node (z 0 in 2D), else 0 [N].
-    fn point_load(&self) -> [f64; 3] {
-        self.loads.point_force(self.scene()).map_or([0.0; 3], |(_, f)| std::array::from_fn(|i| f.get(i).copied().unwrap_or(0.0)))
     }
     /// Coordinates of the kept (modal) or reported (full) modes.
     pub fn modal_coordinates(&self) -> &[f64] {
@@ -378,9 +519,25 @@ impl Simulator {
     /// rest [J]: every spring, whatever the force model; computed when first
     /// asked after a step.
     pub fn potential_energy(&mut self) -> f64 {
+        if !self.fresh.potential && self.turned() {
+            // Elastic energy, and -g . sum m (X - X_rest) = -g . (m a + R S - S_rest), and -f_p . (X_p - X_p,rest).
+            let (d, point) = (self.scene().dim, point_load(&self.loads, self.scene()));
+            let elastic = self.engine.elastic_energy(&self.state);
+            let s = apply(&rotation(&self.state.rotation), &self.engine.first_moment(&self.state));
+            let g: [f64; 3] = std::array::from_fn(|i| if i < d { self.loads.gravity[i] } else { 0.0 });
+            let lowered: [f64; 3] = std::array::from_fn(|i| self.free_mass * self.state.anchor[i] + s[i] - self.rest_moment[i]);
+            let mut potential = elastic - dot(&g, &lowered);
+            if let (Some(node), true) = (self.loads.load_node, point != [0.0; 3]) {
+                let x = self.load_node_position().expect("a point load acts on a node of the scene");
+                let slot = self.scene().slot_of_node[node];
+                potential -= (0..d).map(|i| point[i] * (x[i] - self.scene().rest[slot * d + i])).sum::<f64>();
+            }
+            self.outputs.potential = potential;
+            self.fresh.potential = true;
+        }
         if !self.fresh.potential {
             // The anchor's displacement a moves every free node: -(m g + f_p) . a more.
-            let (d, point) = (self.scene().dim, self.point_load());
+            let (d, point) = (self.scene().dim, point_load(&self.loads, self.scene()));
             let shifted: f64 = (0..d).map(|i| (self.free_mass * self.loads.gravity[i] + point[i]) * self.state.anchor[i]).sum();
             self.outputs.potential = self.engine.potential_energy(&self.loads, &self.state) - shifted;
             self.fresh.potential = true;
@@ -391,7 +548,8 @@ impl Simulator {
     /// to the load (0 in full space); computed when first asked after a step.
     pub fn force_residual(&mut self) -> f64 {
         if !self.fresh.residual {
-            self.outputs.force_residual = self.engine.force_residual(&self.loads, &self.state);
+            let loads = if self.turned() { &self.local } else { &self.loads };
+            self.outputs.force_residual = self.engine.force_residual(loads, &self.state);
             self.fresh.residual = true;
         }
         self.outputs.force_residual
@@ -415,13 +573,17 @@ impl Simulator {
         }
         loads.validate(self.settings.n_modes)?;
         loads.validate_on(self.scene())?;
+        if !self.engine.turns() && planar(&loads.rotation, self.scene().dim) != self.state.rotation {
+            return Err(PhysicsError::SchemeCannotTurn { scheme: self.settings.integrator });
+        }
         if loads.same_but_anchor(&self.loads) {
-            // The anchor's target acts from the next step on; nothing moves now.
+            // The anchor's and the holder's targets act from the next step on; nothing moves now.
             self.loads.anchor = loads.anchor;
+            self.loads.rotation = loads.rotation;
             return Ok(());
         }
         self.loads.clone_from(loads);
-        self.engine.apply_loads(&self.loads);
+        self.apply_loads();
         self.engine.settle(&self.loads, &mut self.state);
         self.refresh_outputs();
         Ok(())
@@ -446,9 +608,12 @@ impl Simulator {
         }
         s.loads.validate(self.settings.n_modes)?;
         s.loads.validate_on(self.scene())?;
+        if !self.engine.turns() && (s.state.spin != [0.0; 3] || s.state.rotation != planar(&s.loads.rotation, self.scene().dim)) {
+            return Err(PhysicsError::SchemeCannotTurn { scheme: self.settings.integrator });
+        }
         self.loads.clone_from(&s.loads);
-        self.engine.apply_loads(&self.loads);
         self.state.copy_from(&s.state);
+        self.apply_loads();
         self.engine.evaluate(&self.loads, &self.state);
         self.refresh_outputs();
         Ok(())
@@ -465,4 +630,50 @@ fn shift(values: &mut [f64], a: &[f64; 3], d: usize) {
             }
         }
     }
+}
+
+/// A rotation vector as the scene can turn: about z alone in 2D.
+fn planar(theta: &[f64; 3], d: usize) -> [f64; 3] {
+    if d == 2 {
+        [0.0, 0.0, theta[2]]
+    } else {
+        *theta
+    }
+}
+
+/// R^T v for a ground-frame vector `v` of the scene's dimension (z ignored in 2D).
+fn into_frame(r: &[f64; 9], v: &[f64; 3], d: usize) -> [f64; 3] {
+    apply_transposed(r, &std::array::from_fn(|i| if i < d { v[i] } else { 0.0 }))
+}
+
+/// `local` = `loads` with gravity and the point load turned into the
+/// frame of orientation `r`, reusing `local`'s buffers.
+fn turn_loads(local: &mut Loads, loads: &Loads, r: &[f64; 9], d: usize) {
+    local.clone_from(loads);
+    local.gravity = into_frame(r, &loads.gravity, d);
+    local.point_load = into_frame(r, &loads.point_load, d);
+}
+
+/// The point load of `loads` where it acts, on a free load node (z 0 in 2D), else 0 [N].
+fn point_load(loads: &Loads, scene: &Scene) -> [f64; 3] {
+    loads.point_force(scene).map_or([0.0; 3], |(_, f)| std::array::from_fn(|i| f.get(i).copied().unwrap_or(0.0)))
+}
+
+/// X0 + a + R (x - X0): a position `x` in the frame of a holder at
+/// orientation `r` and displacement `a`, in the ground's.
+fn place(pivot: &[f64; 3], a: &[f64; 3], r: &[f64; 9], x: &[f64]) -> [f64; 3] {
+    let d = x.len();
+    let rho: [f64; 3] = std::array::from_fn(|i| if i < d { x[i] - pivot[i] } else { 0.0 });
+    let p = apply(r, &rho);
+    std::array::from_fn(|i| if i < d { pivot[i] + a[i] + p[i] } else { 0.0 })
+}
+
+/// c + R (v + w x (x - X0)): a velocity `v` at `x` in the frame of a holder
+/// at orientation `r` moving at c and turning at w, in the ground's.
+fn ground_velocity(pivot: &[f64; 3], c: &[f64; 3], w: &[f64; 3], r: &[f64; 9], v: &[f64], x: &[f64]) -> [f64; 3] {
+    let d = x.len();
+    let rho: [f64; 3] = std::array::from_fn(|i| if i < d { x[i] - pivot[i] } else { 0.0 });
+    let spun = cross(w, &rho);
+    let u = apply(r, &std::array::from_fn(|i| if i < d { v[i] } else { 0.0 } + spun[i]));
+    std::array::from_fn(|i| if i < d { c[i] + u[i] } else { 0.0 })
 }

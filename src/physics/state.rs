@@ -11,6 +11,10 @@
 use super::error::{non_negative, PhysicsError, Quantity};
 use super::scene::Scene;
 
+/// Largest component of the holder's rotation vector [rad]: 1e6 rad is
+/// 160 000 turns, and keeps the angle's round-off below 1e-10 rad.
+pub const MAX_ROTATION: f64 = 1e6;
+
 /// Coordinates y, rates y' and accelerations y'' of the generalized
 /// coordinates, and the time since the start of the run.
 #[derive(Clone, Debug, PartialEq)]
@@ -30,12 +34,19 @@ pub struct State {
     pub anchor: [f64; 3],
     /// Velocity of the anchor over the last communication step [m/s].
     pub anchor_rate: [f64; 3],
+    /// The holder's orientation at `time`, as the rotation vector theta
+    /// (axis x angle) from its rest orientation [rad]; only z in 2D. y
+    /// measures the free DOFs in the holder's frame (`docs/method.md`, section 8).
+    pub rotation: [f64; 3],
+    /// The holder's angular velocity in its own axes over the last
+    /// communication step [rad/s].
+    pub spin: [f64; 3],
 }
 
 impl State {
     /// At rest at the linearization point, at time 0, with `n` coordinates.
     pub fn at_rest(n: usize) -> Self {
-        State { time: 0.0, y: vec![0.0; n], v: vec![0.0; n], a: vec![0.0; n], anchor: [0.0; 3], anchor_rate: [0.0; 3] }
+        State { time: 0.0, y: vec![0.0; n], v: vec![0.0; n], a: vec![0.0; n], anchor: [0.0; 3], anchor_rate: [0.0; 3], rotation: [0.0; 3], spin: [0.0; 3] }
     }
 
     /// Number of generalized coordinates.
@@ -55,11 +66,23 @@ impl State {
         self.a.copy_from_slice(&other.a);
         self.anchor = other.anchor;
         self.anchor_rate = other.anchor_rate;
+        self.rotation = other.rotation;
+        self.spin = other.spin;
     }
 
     /// Every value is a finite number.
     pub fn is_finite(&self) -> bool {
-        self.time.is_finite() && self.y.iter().chain(&self.v).chain(&self.a).chain(&self.anchor).chain(&self.anchor_rate).all(|x| x.is_finite())
+        self.time.is_finite()
+            && self
+                .y
+                .iter()
+                .chain(&self.v)
+                .chain(&self.a)
+                .chain(&self.anchor)
+                .chain(&self.anchor_rate)
+                .chain(&self.rotation)
+                .chain(&self.spin)
+                .all(|x| x.is_finite())
     }
 }
 
@@ -81,6 +104,11 @@ pub struct Loads {
     /// is ignored in 2D. Over the step the anchor moves linearly from where
     /// it is ([`State::anchor`]) to here (`docs/method.md`, section 8).
     pub anchor: [f64; 3],
+    /// The holder's orientation at the end of the next communication step,
+    /// as a rotation vector from its rest orientation [rad]; x and y are
+    /// ignored in 2D. Over the step the holder turns at a constant rate
+    /// from where it is ([`State::rotation`]) to here (`docs/method.md`, section 8).
+    pub rotation: [f64; 3],
     /// Rayleigh mass-proportional damping alpha [1/s].
     pub damping_alpha: f64,
     /// Rayleigh stiffness-proportional damping beta [s].
@@ -97,6 +125,7 @@ impl Clone for Loads {
             point_load: self.point_load,
             load_node: self.load_node,
             anchor: self.anchor,
+            rotation: self.rotation,
             damping_alpha: self.damping_alpha,
             damping_beta: self.damping_beta,
             mode_weights: self.mode_weights.clone(),
@@ -110,6 +139,7 @@ impl Clone for Loads {
         self.point_load = source.point_load;
         self.load_node = source.load_node;
         self.anchor = source.anchor;
+        self.rotation = source.rotation;
         self.damping_alpha = source.damping_alpha;
         self.damping_beta = source.damping_beta;
         self.mode_weights.clone_from(&source.mode_weights);
@@ -124,6 +154,7 @@ impl Loads {
             point_load: [0.0; 3],
             load_node: None,
             anchor: [0.0; 3],
+            rotation: [0.0; 3],
             damping_alpha: 0.0,
             damping_beta: 0.0,
             mode_weights: vec![1.0; n_modes],
@@ -151,7 +182,7 @@ impl Loads {
 
     /// Refuses loads that do not fit `scene`: a non-zero point load on a
     /// node that is held or not in the scene.
-    /// The same loads apart from the anchor's target.
+    /// The same loads apart from the anchor's and the holder's targets.
     pub fn same_but_anchor(&self, other: &Loads) -> bool {
         self.gravity == other.gravity
             && self.point_load == other.point_load
@@ -185,6 +216,9 @@ impl Loads {
         }
         if let Some(&a) = self.anchor.iter().find(|a| !a.is_finite()) {
             return Err(PhysicsError::Invalid { quantity: Quantity::Anchor, value: a, expected: super::error::Expected::Finite });
+        }
+        if let Some(&a) = self.rotation.iter().find(|a| !(a.abs() <= MAX_ROTATION)) {
+            return Err(PhysicsError::Invalid { quantity: Quantity::Rotation, value: a, expected: super::error::Expected::Within(MAX_ROTATION) });
         }
         non_negative(Quantity::DampingAlpha, self.damping_alpha)?;
         non_negative(Quantity::DampingBeta, self.damping_beta)?;

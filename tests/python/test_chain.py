@@ -134,7 +134,14 @@ def test_fmt_container(default_fmu, runs, tmp_path, sequential):
     c = chain.run_container(path, h, STOP)
     ref = runs(scheme, h, anchor="absolute")
     assert np.array_equal(c["time"], ref["time"])
-    assert_bitwise(c, ref, STATE_OUTPUTS)
+    # A's anchor force depends on A's load directly (the share of the load its basis cannot hold goes
+    # straight to the holder), so it too is read before the exchange here and after it by the master;
+    # every mode is kept, so the two differ by round-off alone.
+    feedthrough = ["A.anchorForceX", "A.anchorForceY"]
+    assert_bitwise(c, ref, [n for n in STATE_OUTPUTS if n not in feedthrough])
+    scale = np.abs(ref["A.anchorForceY"]).max()
+    for n in feedthrough:
+        assert np.abs(c[n] - ref[n]).max() <= 1e-13 * scale, n
     pe = pre_exchange_potential(ref)
     rel = np.abs(c["A.potentialEnergy"] - pe).max() / np.abs(pe).max()
     differs = np.abs(c["A.potentialEnergy"] - ref["A.potentialEnergy"]).max()
@@ -328,7 +335,7 @@ def test_implicit_chain_converges_to_the_explicit_chain_at_small_steps(stiff, sh
 # unstable on each pair, over 3 s: a step discarded or energy that rises
 # from one half second to the next; at half of it the energy falls.
 EXPLICIT_LIMITS = {("full", "gauss-seidel"): 2.0**-8, ("full", "jacobi"): 2.0**-10,
-                   ("modes20", "gauss-seidel"): 2.0**-7, ("modes20", "jacobi"): 2.0**-9}
+                   ("modes20", "gauss-seidel"): 2.0**-6, ("modes20", "jacobi"): 2.0**-9}
 
 
 @pytest.mark.parametrize("sheets,scheme", list(EXPLICIT_LIMITS), ids="-".join)

@@ -44,7 +44,11 @@ INTERFACE = {
     "anchorX": ("Float64", "input", "continuous"),
     "anchorY": ("Float64", "input", "continuous"),
     "anchorZ": ("Float64", "input", "continuous"),
+    "anchorRX": ("Float64", "input", "continuous"),
+    "anchorRY": ("Float64", "input", "continuous"),
+    "anchorRZ": ("Float64", "input", "continuous"),
     "anchorMotion": ("Boolean", "parameter", "fixed"),
+    "anchorRotation": ("Boolean", "parameter", "fixed"),
     "positions": ("Float64", "output", "continuous"),
     "velocities": ("Float64", "output", "continuous"),
     "modalCoordinates": ("Float64", "output", "continuous"),
@@ -60,6 +64,9 @@ INTERFACE = {
     "anchorForceX": ("Float64", "output", "continuous"),
     "anchorForceY": ("Float64", "output", "continuous"),
     "anchorForceZ": ("Float64", "output", "continuous"),
+    "anchorTorqueX": ("Float64", "output", "continuous"),
+    "anchorTorqueY": ("Float64", "output", "continuous"),
+    "anchorTorqueZ": ("Float64", "output", "continuous"),
     "cubatureSprings": ("UInt64", "calculatedParameter", "fixed"),
     "modeFrequencies": ("Float64", "calculatedParameter", "fixed"),
     "springNeighbours": ("UInt64", "calculatedParameter", "fixed"),
@@ -147,6 +154,8 @@ def test_interface(any_fmu):
         "loadNodeX": "m", "loadNodeY": "m", "loadNodeZ": "m",
         "loadNodeVX": "m/s", "loadNodeVY": "m/s", "loadNodeVZ": "m/s",
         "anchorForceX": "N", "anchorForceY": "N", "anchorForceZ": "N",
+        "anchorTorqueX": "N.m", "anchorTorqueY": "N.m", "anchorTorqueZ": "N.m",
+        "anchorRX": "rad", "anchorRY": "rad", "anchorRZ": "rad",
     }
     defined = {u.name for u in md.unitDefinitions}
     for name, unit in units.items():

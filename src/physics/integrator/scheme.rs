@@ -23,6 +23,10 @@ pub trait Scheme: Send + 'static {
     /// Values per coordinate the scheme keeps in [`Buffers::scheme`].
     const SCRATCH: usize = 0;
 
+    /// The scheme integrates forces that depend on the rates other than
+    /// through the damping, as the Coriolis force of a turning holder does.
+    const TURNS: bool = true;
+
     /// Refuses, at set-up, a space the scheme cannot integrate.
     fn check<S: Space>(_space: &S, _w: &S::Work) -> Result<(), PhysicsError> {
         Ok(())

@@ -4,7 +4,7 @@
 
 use crate::physics::bake::SetupData;
 use crate::physics::error::StepFailure;
-use crate::physics::frame::Moments;
+use crate::physics::frame::{Frame, Moments};
 use crate::physics::scene::Scene;
 use crate::physics::state::Loads;
 
@@ -92,6 +92,18 @@ pub trait Space: Send + Sized + 'static {
     /// weight like a load: the velocity kick of an anchor whose velocity
     /// changes by -c (`docs/method.md`, section 8).
     fn add_translation_rate(&self, loads: &Loads, c: &[f64; 3], v: &mut [f64]);
+    /// Adds to the rates `v` at coordinates `y` those of a rigid rotation of
+    /// the free nodes about the pivot with angular velocity `c`, c x (x - X0),
+    /// weighted like a load: the velocity kick of a holder whose spin
+    /// changes by -c (`docs/method.md`, section 8).
+    fn add_rotation_rate(&self, loads: &Loads, c: &[f64; 3], y: &[f64], v: &mut [f64]);
+    /// The holder has turned (`docs/method.md`, section 8): until the next
+    /// [`Space::apply_loads`] the equations are those of its frame: gravity
+    /// and the point load as `frame` turns them, the centrifugal force of
+    /// its spin with the forces, its Coriolis force with the damping
+    /// (in every method above that takes C). Called after
+    /// [`Space::apply_loads`], and for every internal step while the holder turns.
+    fn turn(&self, loads: &Loads, frame: &Frame, w: &mut Self::Work);
 }
 
 /// What is read from a space's coordinates: positions, velocities,
@@ -138,9 +150,6 @@ pub trait Readout: Space {
     /// The mass moments of the free nodes about the pivot at coordinates y
     /// and rates v (see [`Moments`]; O(r^2) in the modal space).
     fn moments(&self, y: &[f64], v: &[f64]) -> Moments;
-    /// z = a + M^-1 C v: the acceleration the forces other than damping
-    /// give, with the damping's reaction on the holder (`docs/method.md`, section 8).
-    fn undamped_acceleration(&self, v: &[f64], a: &[f64], w: &mut Self::Work, z: &mut [f64]);
     /// Velocities of the free DOFs.
     fn dof_velocities(&self, v: &[f64], out: &mut [f64]);
     /// Coordinates of the kept or reported modes at y.

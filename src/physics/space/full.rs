@@ -20,7 +20,7 @@ use super::equations::{Diagonal, Layout, Readout, Space};
 use crate::physics::basis;
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::forces::{linearize, omega_sq_bound_full, SpringForces, SpringScratch, StiffnessPattern};
-use crate::physics::frame::{add_outer, Moments};
+use crate::physics::frame::{add_outer, cross, dot, Frame, Moments};
 use crate::physics::modes::ModalBasis;
 use crate::physics::scene::Scene;
 use crate::physics::settings::Settings;
@@ -41,7 +41,15 @@ pub struct Full {
     frequencies: Vec<f64>,
     omega_sq_bound: f64,
     newton_scale: f64,
+    /// The pivot X0.
+    pivot: [f64; 3],
+    /// In 3D, per free node, the positions of its (x, y), (x, z), (y, z)
+    /// entries in the stiffness pattern (SKIP where none).
+    node_pairs: Vec<[usize; 3]>,
 }
+
+/// No entry in the pattern.
+const SKIP: usize = usize::MAX;
 
 /// Load terms and scratch of a full-space run.
 pub struct FullWork {
@@ -63,6 +71,12 @@ pub struct FullWork {
     mem: MemBuffer,
     /// (dt, alpha, beta) for which `l_values` holds M + dt/2 C (explicit, beta > 0).
     explicit_factor: Option<(f64, f64, f64)>,
+    /// The holder's frame has left its rest orientation ([`Space::turn`]), and its spin.
+    turning: bool,
+    spin: [f64; 3],
+    /// The right side and the previous iterate of the Coriolis velocity update.
+    rhs: Vec<f64>,
+    previous: Vec<f64>,
 }
 
 impl Full {
@@ -83,7 +97,16 @@ impl Full {
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx);
         let symbolic = factorize_symbolic_cholesky(sym, Side::Upper, SymmetricOrdering::Amd, Default::default())
             .map_err(|e| PhysicsError::LinearAlgebra { what: "sparse Cholesky analysis", detail: format!("{e:?}") })?;
+        let node_pairs = if scene.dim == 3 {
+            let find =
+                |r: usize, c: usize| pattern.row_idx[pattern.col_ptr[c]..pattern.col_ptr[c + 1]].binary_search(&r).map_or(SKIP, |i| pattern.col_ptr[c] + i);
+            (0..scene.n_free).map(|k| [find(3 * k, 3 * k + 1), find(3 * k, 3 * k + 2), find(3 * k + 1, 3 * k + 2)]).collect()
+        } else {
+            Vec::new()
+        };
         Ok(Full {
+            pivot: scene.pivot(),
+            node_pairs,
             springs: SpringForces::new(&scene),
             frequencies: reported.as_ref().map(|b| b.frequencies()).unwrap_or_default(),
             omega_sq_bound: omega_sq_bound_full(&scene),
@@ -123,6 +146,36 @@ impl Full {
         if tangent {
             self.pattern.add_tangent(&self.scene, &w.x, 1.0, &mut w.matrix);
         }
+        self.factorize_matrix(w)
+    }
+
+    /// The Newton matrix c_m M + c_k K0 + K(x) - m (Omega^2 I - Omega Omega^T) per node.
+    fn factorize_with_spin(&self, c_m: f64, c_k: f64, spin: &[f64; 3], w: &mut FullWork) -> Result<(), StepFailure> {
+        if *spin == [0.0; 3] {
+            return self.factorize(c_m, c_k, true, w);
+        }
+        for (m, k) in w.matrix.iter_mut().zip(&self.k0) {
+            *m = c_k * k;
+        }
+        let (d, w2) = (self.scene.dim, dot(spin, spin));
+        for (k, &pos) in self.pattern.diag.iter().enumerate() {
+            let i = k % d;
+            w.matrix[pos] += c_m * self.scene.dof_mass[k] - self.scene.dof_mass[k] * (w2 - spin[i] * spin[i]);
+        }
+        for (k, pairs) in self.node_pairs.iter().enumerate() {
+            let m = self.scene.dof_mass[3 * k];
+            for (&pos, (a, b)) in pairs.iter().zip([(0, 1), (0, 2), (1, 2)]) {
+                if pos != SKIP {
+                    w.matrix[pos] += m * spin[a] * spin[b];
+                }
+            }
+        }
+        self.pattern.add_tangent(&self.scene, &w.x, 1.0, &mut w.matrix);
+        self.factorize_matrix(w)
+    }
+
+    /// Factorizes `w.matrix` into `w.l_values`: LL^T, else LDL^T.
+    fn factorize_matrix(&self, w: &mut FullWork) -> Result<(), StepFailure> {
         let n = self.scene.n_dofs();
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.pattern.col_ptr, None, &self.pattern.row_idx);
         let a = SparseColMatRef::new(sym, &w.matrix);
@@ -143,6 +196,67 @@ impl Full {
             .map_err(|_| StepFailure::Buckled)
     }
 }
+
+impl Full {
+    /// Adds s 2 (Omega x v) per node to `out`, times m_k when `mass`.
+    fn add_coriolis(&self, v: &[f64], spin: [f64; 3], s: f64, mass: bool, out: &mut [f64]) {
+        let d = self.scene.dim;
+        for (k, o) in out.chunks_exact_mut(d).enumerate() {
+            let vel: [f64; 3] = std::array::from_fn(|i| if i < d { v[k * d + i] } else { 0.0 });
+            let c = cross(&spin, &vel);
+            let m = if mass { self.scene.dof_mass[k * d] } else { 1.0 };
+            for i in 0..d {
+                o[i] += s * 2.0 * m * c[i];
+            }
+        }
+    }
+
+    /// Solves (M + dt/2 C + dt M [Omega]x) v1 = rhs, `v1` holding rhs on entry.
+    fn coriolis_velocity(&self, dt: f64, w: &mut FullWork, v1: &mut [f64]) -> Result<(), StepFailure> {
+        let (d, spin) = (self.scene.dim, w.spin);
+        let mass = &self.scene.dof_mass;
+        if w.beta == 0.0 {
+            // Per node m ((1 + dt/2 alpha) I + [dt Omega]x) v = b: with a = 1 + dt/2 alpha, s = dt Omega, c = b / m,
+            // v = (a^2 c - a (s x c) + (s . c) s) / (a (a^2 + |s|^2)).
+            let a = 1.0 + 0.5 * dt * w.alpha;
+            let s: [f64; 3] = std::array::from_fn(|i| dt * spin[i]);
+            let den = a * (a * a + dot(&s, &s));
+            for (k, vk) in v1.chunks_exact_mut(d).enumerate() {
+                let c: [f64; 3] = std::array::from_fn(|i| if i < d { vk[i] / mass[k * d] } else { 0.0 });
+                let (sc, along) = (cross(&s, &c), dot(&s, &c));
+                for i in 0..d {
+                    vk[i] = (a * a * c[i] - a * sc[i] + along * s[i]) / den;
+                }
+            }
+            return Ok(());
+        }
+        // v1 = (M + dt/2 C)^-1 (rhs - dt M (Omega x v1)), from v1 = 0.
+        let key = (dt, w.alpha, w.beta);
+        if w.explicit_factor != Some(key) {
+            w.explicit_factor = None;
+            self.factorize(1.0 + 0.5 * dt * w.alpha, 0.5 * dt * w.beta, false, w)?;
+            w.explicit_factor = Some(key);
+        }
+        w.rhs.copy_from_slice(v1);
+        w.previous.fill(0.0);
+        for _ in 0..MAX_CORIOLIS_ITERATIONS {
+            v1.copy_from_slice(&w.rhs);
+            // rhs - dt M (Omega x previous)
+            self.add_coriolis(&w.previous, spin, -0.5 * dt, true, v1);
+            self.solve(w, v1);
+            let change = v1.iter().zip(&w.previous).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            let size = v1.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+            w.previous.copy_from_slice(v1);
+            if change <= 1e-13 * size {
+                return Ok(());
+            }
+        }
+        Err(StepFailure::CoriolisNotConverged { turn: dt * dot(&spin, &spin).sqrt(), dt })
+    }
+}
+
+/// Iterates of the Coriolis velocity update before a step is refused.
+const MAX_CORIOLIS_ITERATIONS: usize = 100;
 
 impl Space for Full {
     type Work = FullWork;
@@ -182,6 +296,10 @@ impl Space for Full {
             indefinite: false,
             mem: MemBuffer::new(req),
             explicit_factor: None,
+            turning: false,
+            spin: [0.0; 3],
+            rhs: vec![0.0; n],
+            previous: vec![0.0; n],
         }
     }
 
@@ -203,21 +321,69 @@ impl Space for Full {
                 *g += fi;
             }
         }
+        w.turning = false;
     }
 
-    /// h(u) = f_springs(x* + u) + M g + f_p.
+    /// M R^T g + R^T f_p per DOF, and the spin.
+    fn turn(&self, loads: &Loads, frame: &Frame, w: &mut FullWork) {
+        let d = self.scene.dim;
+        for (k, g) in w.gravity.iter_mut().enumerate() {
+            *g = self.scene.dof_mass[k] * frame.gravity[k % d];
+        }
+        if let Some((dof, _)) = loads.point_force(&self.scene) {
+            for (i, g) in w.gravity[dof..dof + d].iter_mut().enumerate() {
+                *g += frame.load[i];
+            }
+        }
+        w.turning = true;
+        w.spin = frame.spin;
+    }
+
+    /// u' += c x (x_rest + u - X0) on every free node.
+    fn add_rotation_rate(&self, _loads: &Loads, c: &[f64; 3], u: &[f64], v: &mut [f64]) {
+        let d = self.scene.dim;
+        for (k, vk) in v.chunks_exact_mut(d).enumerate() {
+            let rho: [f64; 3] = std::array::from_fn(|i| if i < d { self.scene.rest[k * d + i] + u[k * d + i] - self.pivot[i] } else { 0.0 });
+            let dv = cross(c, &rho);
+            for i in 0..d {
+                vk[i] += dv[i];
+            }
+        }
+    }
+
+    /// h(u) = f_springs(x* + u) + M g + f_p; turning, with M R^T g + R^T f_p
+    /// and the centrifugal force m (Omega^2 rho - Omega (Omega . rho)), rho = x - X0.
     fn force(&self, _loads: &Loads, u: &[f64], w: &mut FullWork, h: &mut [f64]) {
         for k in 0..u.len() {
             w.x[k] = self.scene.rest[k] + u[k];
         }
         h.copy_from_slice(&w.gravity);
         w.elastic = self.springs.add_to(&self.scene, &w.x, &mut w.springs, h);
+        if w.turning {
+            let (d, spin) = (self.scene.dim, w.spin);
+            let w2 = dot(&spin, &spin);
+            for (k, hk) in h.chunks_exact_mut(d).enumerate() {
+                let m = self.scene.dof_mass[k * d];
+                let rho: [f64; 3] = std::array::from_fn(|i| if i < d { w.x[k * d + i] - self.pivot[i] } else { 0.0 });
+                let along = dot(&spin, &rho);
+                for i in 0..d {
+                    hk[i] += m * (w2 * rho[i] - spin[i] * along);
+                }
+            }
+        }
     }
 
+    /// Turning, (M + dt/2 C + dt M [Omega]x) v1 = the same right side: the
+    /// Coriolis force taken with the damping; node by node in closed form
+    /// without stiffness-proportional damping, else by fixed-point
+    /// iteration on the Coriolis term, which contracts by dt |Omega| per iterate.
     fn explicit_velocity(&self, dt: f64, v: &[f64], a: &[f64], h: &[f64], w: &mut FullWork, v1: &mut [f64]) -> Result<(), StepFailure> {
         let mass = &self.scene.dof_mass;
         for k in 0..v1.len() {
             v1[k] = mass[k] * (v[k] + 0.5 * dt * a[k]) + 0.5 * dt * h[k];
+        }
+        if w.turning && w.spin != [0.0; 3] {
+            return self.coriolis_velocity(dt, w, v1);
         }
         if w.beta != 0.0 {
             // (M + dt/2 C) is constant while dt and the damping are: factor once.
@@ -241,6 +407,9 @@ impl Space for Full {
         for k in 0..a.len() {
             a[k] = (h[k] - w.cv[k]) / self.scene.dof_mass[k];
         }
+        if w.turning {
+            self.add_coriolis(v, w.spin, -1.0, false, a);
+        }
     }
 
     fn residual(&self, v: &[f64], a: &[f64], h: &[f64], w: &mut FullWork, r: &mut [f64]) {
@@ -248,12 +417,20 @@ impl Space for Full {
         for k in 0..r.len() {
             r[k] = -(self.scene.dof_mass[k] * a[k] + w.cv[k] - h[k]);
         }
+        if w.turning {
+            self.add_coriolis(v, w.spin, -1.0, true, r);
+        }
     }
 
-    /// c_m M + c_c (alpha M + beta K0) + K(x): the tangent of -h is the stiffness K(x).
+    /// c_m M + c_c (alpha M + beta K0) + K(x): the tangent of -h is the
+    /// stiffness K(x). Turning, the centrifugal force's softening
+    /// -m (Omega^2 I - Omega Omega^T) joins it; the Coriolis term's skew part
+    /// c_c 2 M [Omega]x is left out of the symmetric factor, so Newton then
+    /// converges at a rate of about dt |Omega| per iterate instead of quadratically.
     fn factor(&self, _loads: &Loads, c_m: f64, c_c: f64, w: &mut FullWork) -> Result<(), StepFailure> {
         w.explicit_factor = None;
-        self.factorize(c_m + c_c * w.alpha, c_c * w.beta, true, w)
+        let spin = if w.turning { w.spin } else { [0.0; 3] };
+        self.factorize_with_spin(c_m + c_c * w.alpha, c_c * w.beta, &spin, w)
     }
 
     fn solve(&self, w: &mut FullWork, rhs: &mut [f64]) {
@@ -353,14 +530,6 @@ impl Readout for Full {
             add_outer(&mut out.flux, *m, &vel, &rho);
         }
         out
-    }
-
-    /// z = a + M^-1 C v.
-    fn undamped_acceleration(&self, v: &[f64], a: &[f64], w: &mut FullWork, z: &mut [f64]) {
-        self.damping_times(v, w);
-        for k in 0..z.len() {
-            z[k] = a[k] + w.cv[k] / self.scene.dof_mass[k];
-        }
     }
 
     fn dof_velocities(&self, v: &[f64], out: &mut [f64]) {

@@ -13,7 +13,7 @@
 //!     H_ij = sum m_k phi_ik (x) phi_jk,
 //! ```
 //!
-//! and at coordinates q, rates v (rho = s + Phi q):
+//! (tr H_ij = delta_ij, Phi^T M Phi = I), and at coordinates q, rates v (rho = s + Phi q):
 //!
 //! ```text
 //!     S = S0 + sum_j T_j q_j,        J = J0 + sum_j q_j (G_j + G_j^T) + sum_ij q_i q_j H_ij,
@@ -24,7 +24,7 @@ use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, Par};
 
 use super::reduced::Modes;
-use crate::physics::frame::{add_outer, Moments};
+use crate::physics::frame::{add_outer, apply, dot, Moments};
 use crate::physics::scene::Scene;
 
 /// The invariants of one basis; see the module documentation.
@@ -128,4 +128,55 @@ impl Inertia {
         }
         m
     }
+
+    /// The terms of a holder turning at Omega (`docs/method.md`, section 8):
+    /// the generalized centrifugal force Phi^T M (Omega^2 rho - Omega (Omega . rho)) = c0 + Kc q,
+    ///
+    /// ```text
+    ///     c0_j = Omega^2 tr G_j - Omega^T G_j Omega,    Kc_ji = Omega^2 tr H_ji - Omega^T H_ji Omega,
+    /// ```
+    ///
+    /// and the Coriolis matrix Gamma, -2 Phi^T M (Omega x Phi q') = -Gamma q',
+    /// Gamma_ji = 2 Omega . B_ij with B_ij = sum m phi_ik x phi_jk (skew). `kc` and
+    /// `gamma` are r x r, row j holding the forces on mode j.
+    pub fn spin_terms(&self, spin: &[f64; 3], c0: &mut [f64], kc: &mut [f64], gamma: &mut [f64]) {
+        let r = c0.len();
+        let w2 = dot(spin, spin);
+        let quad = |t: &[f64]| w2 * (t[0] + t[4] + t[8]) - dot(spin, &apply(t.try_into().expect("9 values"), spin));
+        for (j, g) in self.spread.chunks_exact(9).enumerate() {
+            c0[j] = quad(g);
+        }
+        for j in 0..r {
+            for i in 0..r {
+                kc[j * r + i] = quad(&self.pair[(j * r + i) * 9..(j * r + i) * 9 + 9]);
+                gamma[j * r + i] = 2.0 * dot(spin, &skew(&self.pair[(i * r + j) * 9..(i * r + j) * 9 + 9]));
+            }
+        }
+    }
+
+    /// (Phi^T M (c x rho))_j at coordinates q: the modal rate of mode j in a
+    /// rigid rotation with angular velocity c about the pivot,
+    /// c . (A_j + sum_i q_i B_ij) with A_j = sum m s_k x phi_jk (the skew part of G_j), O(r).
+    pub fn rotation_rate(&self, j: usize, c: &[f64; 3], q: &[f64]) -> f64 {
+        let r = q.len();
+        let mut arm = skew_swapped(&self.spread[j * 9..j * 9 + 9]);
+        for (i, qi) in q.iter().enumerate() {
+            let b = skew(&self.pair[(i * r + j) * 9..(i * r + j) * 9 + 9]);
+            for a in 0..3 {
+                arm[a] += qi * b[a];
+            }
+        }
+        dot(c, &arm)
+    }
+}
+
+/// For T = sum m u (x) w (row-major), sum m u x w.
+fn skew(t: &[f64]) -> [f64; 3] {
+    [t[5] - t[7], t[6] - t[2], t[1] - t[3]]
+}
+
+/// For T = sum m u (x) w (row-major), sum m w x u.
+fn skew_swapped(t: &[f64]) -> [f64; 3] {
+    let s = skew(t);
+    [-s[0], -s[1], -s[2]]
 }

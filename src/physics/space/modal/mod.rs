@@ -35,7 +35,7 @@ use crate::physics::bake::SetupData;
 use crate::physics::basis;
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::forces::omega_sq_bound_full;
-use crate::physics::frame::Moments;
+use crate::physics::frame::{dot, Frame, Moments};
 use crate::physics::modes::ModalBasis;
 use crate::physics::scene::Scene;
 use crate::physics::settings::Settings;
@@ -61,12 +61,16 @@ pub struct Modal<F: ReducedForce = Exact> {
     inv_mass: Vec<f64>,
     /// The mass moments of the free nodes as polynomials in q.
     inertia: Inertia,
+    /// sum m_k (x*_k - x_rest,k) per axis, for the potential of turned gravity.
+    sag: [f64; 3],
 }
 
 /// Load terms and scratch of a modal run.
 pub struct ModalWork<W> {
     /// c_i = alpha + beta lambda_i.
     damping: Vec<f64>,
+    /// The mode weights w_i of the last [`Space::apply_loads`].
+    weights: Vec<f64>,
     /// Phi^T (M g + f_p): gravity and the point load.
     gravity: Vec<f64>,
     /// w_i (Phi^T (M g + f_p))_i: the part of w_i r_i that does not depend on q.
@@ -86,6 +90,18 @@ pub struct ModalWork<W> {
     perm: Vec<usize>,
     perm_inv: Vec<usize>,
     mem: MemBuffer,
+    /// The holder's frame has left its rest orientation ([`Space::turn`]).
+    turning: bool,
+    spin: [f64; 3],
+    /// The centrifugal force c0 + Kc q and the Coriolis matrix Gamma of the spin (see [`Inertia::spin_terms`]).
+    centrifugal: Vec<f64>,
+    spin_stiffness: Vec<f64>,
+    coriolis: Vec<f64>,
+    /// I (1 + dt/2 c) + dt/2 W Gamma, LU-factored, for the explicit velocity update while turning, and its dt (NaN: stale).
+    velocity: Mat<f64>,
+    velocity_perm: Vec<usize>,
+    velocity_perm_inv: Vec<usize>,
+    velocity_dt: f64,
 }
 
 impl<F: ReducedForce> Modal<F> {
@@ -114,7 +130,12 @@ impl<F: ReducedForce> Modal<F> {
         let omega_sq_bound = force.taut_bound(&scene, &modes).map_or(bound, |b| b.max(bound));
         let inv_mass = scene.dof_mass.iter().map(|m| 1.0 / m).collect();
         let inertia = Inertia::new(&scene, &modes);
-        Ok(Modal { force, frequencies, omega_sq_bound, bound, newton_scale, inv_mass, inertia, modes, scene })
+        let d = scene.dim;
+        let mut sag = [0.0; 3];
+        for k in 0..modes.basis.n {
+            sag[k % d] += scene.dof_mass[k] * (modes.point[k] - scene.rest[k]);
+        }
+        Ok(Modal { force, frequencies, omega_sq_bound, bound, newton_scale, inv_mass, inertia, sag, modes, scene })
     }
 
     /// The kept modes.
@@ -162,6 +183,7 @@ impl<F: ReducedForce> Space for Modal<F> {
             StackReq::any_of(&[lu_in_place_scratch::<usize, f64>(r, r, Par::Seq, Default::default()), solve_in_place_scratch::<usize, f64>(r, 1, Par::Seq)]);
         ModalWork {
             damping: vec![0.0; r],
+            weights: vec![1.0; r],
             gravity: vec![0.0; r],
             weighted_load: vec![0.0; r],
             gravity_offset: 0.0,
@@ -173,6 +195,15 @@ impl<F: ReducedForce> Space for Modal<F> {
             perm: vec![0; r],
             perm_inv: vec![0; r],
             mem: MemBuffer::new(req),
+            turning: false,
+            spin: [0.0; 3],
+            centrifugal: vec![0.0; r],
+            spin_stiffness: vec![0.0; r * r],
+            coriolis: vec![0.0; r * r],
+            velocity: Mat::zeros(r, r),
+            velocity_perm: vec![0; r],
+            velocity_perm_inv: vec![0; r],
+            velocity_dt: f64::NAN,
         }
     }
 
@@ -220,6 +251,35 @@ impl<F: ReducedForce> Space for Modal<F> {
         for ((l, g), wj) in w.weighted_load.iter_mut().zip(&w.gravity).zip(&loads.mode_weights) {
             *l = wj * g;
         }
+        w.weights.copy_from_slice(&loads.mode_weights);
+        w.turning = false;
+        w.velocity_dt = f64::NAN;
+    }
+
+    /// Phi^T (M R^T g + R^T f_p) = sum_i T_i (R^T g)_i + Phi_p^T R^T f_p, O(r), and
+    /// the spin's terms when it changed, O(r^2) (`docs/method.md`, section 8).
+    fn turn(&self, loads: &Loads, frame: &Frame, w: &mut Self::Work) {
+        let (n, r, d) = (self.modes.basis.n, self.modes.basis.r, self.scene.dim);
+        let point = loads.point_force(&self.scene).map(|(dof, _)| dof);
+        for j in 0..r {
+            let t = self.inertia.translation(j);
+            w.gravity[j] = t[0] * frame.gravity[0] + t[1] * frame.gravity[1] + t[2] * frame.gravity[2];
+            if let Some(dof) = point {
+                for i in 0..d {
+                    w.gravity[j] += self.modes.basis.phi[(dof + i) * r + j] * frame.load[i];
+                }
+            }
+            w.weighted_load[j] = loads.mode_weights[j] * w.gravity[j];
+        }
+        w.gravity_offset = -dot(&frame.gravity, &self.sag)
+            - point.map_or(0.0, |dof| (0..d).map(|i| frame.load[i] * (self.modes.point[dof + i] - self.scene.rest[dof + i])).sum());
+        let _ = n;
+        if !w.turning || w.spin != frame.spin {
+            self.inertia.spin_terms(&frame.spin, &mut w.centrifugal, &mut w.spin_stiffness, &mut w.coriolis);
+            w.spin = frame.spin;
+            w.velocity_dt = f64::NAN;
+        }
+        w.turning = true;
     }
 
     fn force(&self, loads: &Loads, q: &[f64], w: &mut Self::Work, h: &mut [f64]) {
@@ -227,6 +287,13 @@ impl<F: ReducedForce> Space for Modal<F> {
         self.force.project(&self.scene, &self.modes, q, &mut w.force, h);
         for (hj, gj) in h.iter_mut().zip(&w.gravity) {
             *hj += gj;
+        }
+        if w.turning {
+            // The centrifugal force of the holder's spin, c0 + Kc q.
+            let r = q.len();
+            for (j, hj) in h.iter_mut().enumerate() {
+                *hj += w.centrifugal[j] + dot_slices(&w.spin_stiffness[j * r..(j + 1) * r], q);
+            }
         }
         w.generalized.copy_from_slice(h);
         // weights act on everything but the mode's own linear spring
@@ -236,22 +303,55 @@ impl<F: ReducedForce> Space for Modal<F> {
         }
     }
 
+    /// Turning, (I + dt/2 (diag c + W Gamma)) v1 = v + dt/2 (a + h): the
+    /// Coriolis force taken with the damping, by an LU factored once per
+    /// step size and spin.
     fn explicit_velocity(&self, dt: f64, v: &[f64], a: &[f64], h: &[f64], w: &mut Self::Work, v1: &mut [f64]) -> Result<(), StepFailure> {
-        for j in 0..self.modes.basis.r {
-            v1[j] = (v[j] + 0.5 * dt * (a[j] + h[j])) / (1.0 + 0.5 * dt * w.damping[j]);
+        let r = self.modes.basis.r;
+        if !w.turning {
+            for j in 0..r {
+                v1[j] = (v[j] + 0.5 * dt * (a[j] + h[j])) / (1.0 + 0.5 * dt * w.damping[j]);
+            }
+            return Ok(());
         }
+        if w.velocity_dt != dt {
+            for j in 0..r {
+                for i in 0..r {
+                    w.velocity[(j, i)] = 0.5 * dt * w.weights[j] * w.coriolis[j * r + i];
+                }
+                w.velocity[(j, j)] += 1.0 + 0.5 * dt * w.damping[j];
+            }
+            let stack = MemStack::new(&mut w.mem);
+            lu_in_place(w.velocity.as_mut(), &mut w.velocity_perm, &mut w.velocity_perm_inv, Par::Seq, stack, Default::default());
+            w.velocity_dt = dt;
+        }
+        for j in 0..r {
+            v1[j] = v[j] + 0.5 * dt * (a[j] + h[j]);
+        }
+        let perm = PermRef::new_checked(&w.velocity_perm, &w.velocity_perm_inv, r);
+        let lu = w.velocity.as_ref();
+        let stack = MemStack::new(&mut w.mem);
+        solve_in_place_with_conj(lu, lu, perm, Conj::No, MatMut::from_column_major_slice_mut(v1, r, 1), Par::Seq, stack);
         Ok(())
     }
 
     fn acceleration(&self, v: &[f64], h: &[f64], w: &mut Self::Work, a: &mut [f64]) {
-        for j in 0..self.modes.basis.r {
+        let r = self.modes.basis.r;
+        for j in 0..r {
             a[j] = h[j] - w.damping[j] * v[j];
+            if w.turning {
+                a[j] -= w.weights[j] * dot_slices(&w.coriolis[j * r..(j + 1) * r], v);
+            }
         }
     }
 
-    fn residual(&self, v: &[f64], a: &[f64], h: &[f64], w: &mut Self::Work, r: &mut [f64]) {
-        for j in 0..self.modes.basis.r {
-            r[j] = -(a[j] + w.damping[j] * v[j] - h[j]);
+    fn residual(&self, v: &[f64], a: &[f64], h: &[f64], w: &mut Self::Work, res: &mut [f64]) {
+        let r = self.modes.basis.r;
+        for j in 0..r {
+            res[j] = -(a[j] + w.damping[j] * v[j] - h[j]);
+            if w.turning {
+                res[j] -= w.weights[j] * dot_slices(&w.coriolis[j * r..(j + 1) * r], v);
+            }
         }
     }
 
@@ -264,6 +364,10 @@ impl<F: ReducedForce> Space for Modal<F> {
         for col in 0..r {
             for row in 0..r {
                 w.jac[(row, col)] = weights[row] * w.kr[col * r + row];
+                if w.turning {
+                    // The Coriolis force with the damping, the centrifugal force's softening with the stiffness.
+                    w.jac[(row, col)] += weights[row] * (c_c * w.coriolis[row * r + col] - w.spin_stiffness[row * r + col]);
+                }
             }
             w.jac[(col, col)] += c_m + c_c * w.damping[col] - (weights[col] - 1.0) * self.modes.basis.lambda[col];
         }
@@ -289,6 +393,13 @@ impl<F: ReducedForce> Space for Modal<F> {
     /// and the weighted generalized load w_i (Phi^T (M g + f_p))_i.
     fn diagonal<'a>(&'a self, w: &'a Self::Work) -> Option<Diagonal<'a>> {
         Some(Diagonal { stiffness: &self.modes.basis.lambda, damping: &w.damping, load: &w.weighted_load })
+    }
+
+    /// q' += w_j Phi^T M (c x rho): a rigid rotation about the pivot, projected and weighted like every load.
+    fn add_rotation_rate(&self, loads: &Loads, c: &[f64; 3], q: &[f64], v: &mut [f64]) {
+        for (j, vj) in v.iter_mut().enumerate() {
+            *vj += loads.mode_weights[j] * self.inertia.rotation_rate(j, c, q);
+        }
     }
 
     /// q' += w_i Phi^T M (1 c): a rigid velocity c of the free nodes,
@@ -409,13 +520,6 @@ impl<F: ReducedForce> Readout for Modal<F> {
         self.inertia.moments(q, v)
     }
 
-    /// z = a + diag(c) v.
-    fn undamped_acceleration(&self, v: &[f64], a: &[f64], w: &mut Self::Work, z: &mut [f64]) {
-        for j in 0..z.len() {
-            z[j] = a[j] + w.damping[j] * v[j];
-        }
-    }
-
     /// Phi q'.
     fn dof_velocities(&self, v: &[f64], out: &mut [f64]) {
         self.modes.expand_rates(v, out);
@@ -445,4 +549,10 @@ fn check_prebuilt(scene: &Scene, n_modes: usize, data: &SetupData) -> Result<(),
         }
     }
     Ok(())
+}
+
+/// sum a_i b_i.
+#[inline]
+fn dot_slices(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
