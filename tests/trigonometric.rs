@@ -12,7 +12,7 @@ use common::*;
 use modal_mass_spring::fmi::variables::vr;
 use modal_mass_spring::physics::engine::{Engine, Stepper};
 use modal_mass_spring::physics::error::StepFailure;
-use modal_mass_spring::physics::frame::Moments;
+use modal_mass_spring::physics::frame::{Frame, Moments};
 use modal_mass_spring::physics::integrator::{Propagator, Trigonometric};
 use modal_mass_spring::physics::space::{Diagonal, Layout, Readout, Space};
 use modal_mass_spring::physics::*;
@@ -215,6 +215,8 @@ impl Space for Linear {
         Some(Diagonal { stiffness: &self.lambda, damping: &w.damping, load: &w.load })
     }
     fn add_translation_rate(&self, _loads: &Loads, _c: &[f64; 3], _v: &mut [f64]) {}
+    fn add_rotation_rate(&self, _loads: &Loads, _c: &[f64; 3], _y: &[f64], _v: &mut [f64]) {}
+    fn turn(&self, _loads: &Loads, _frame: &Frame, _w: &mut LinearWork) {}
 }
 
 impl Readout for Linear {

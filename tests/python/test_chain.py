@@ -279,11 +279,17 @@ def test_implicit_chain_runs_where_the_explicit_chain_is_discarded(default_fmu, 
         # B's anchor ends every step where A's load node does
         for axis in "XY":
             assert np.array_equal(r[f"B.anchor{axis}"], r[f"A.loadNode{axis}"] - r["A.restNode"]["XY".index(axis)])
-        # measured: in full space every step lowers the energy, by 2.9e-5 J
-        # at least; the modal energies of 20 modes rise by up to 3e-4 J in a
-        # step (by 1.5e-5 J in the explicit chain at 2^-11 s), their peaks fall
+        # the energy peaks fall; within a step the energy may rise by the
+        # coupling's discretization error, which falls fast with the step: in
+        # full space (B's anchor force carries its damping's reaction) measured
+        # 1.8e-4 J in 7 of 200 steps at 0.01 s, 1.3e-5 J at 0.005 s, none at
+        # 0.0025 s; the modal energies of 20 modes rise by up to 3e-4 J in a
+        # step (by 1.5e-5 J in the explicit chain at 2^-11 s)
         if sheets == "full":
-            assert np.diff(e).max() < 0.0
+            rise = max(np.diff(e).max(), 0.0)
+            finer = max(np.diff(chain.total_energy(stiff(sheets, scheme, h / 2))).max(), 0.0)
+            print(f"{sheets}, {scheme}: largest rise of the energy in a step {rise:.1e} J at h, {finer:.1e} J at h / 2")
+            assert finer <= 0.25 * rise
         assert np.all(np.diff(half_second_peaks(r)) < 0)
     gap = max(np.abs(runs["aitken"][n] - runs["iqn-ils"][n]).max() for n in NODES)
     print(f"{sheets}: Aitken and IQN-ILS {gap:.1e} m apart")
