@@ -148,6 +148,39 @@ fn do_step(c: &mut Criterion) {
             t.elapsed()
         })
     });
+    // The same with the ports read after every step: the holder's force
+    // (O(r)), its torque too (O(r^2)), and with the holder turning.
+    let read = |names: &[u32]| {
+        let mut sum = 0.0;
+        for r in names {
+            let mut v = 0.0;
+            assert_eq!(unsafe { fmi3GetFloat64(inst, r, 1, &mut v, 1) }, fmi3Status_fmi3OK);
+            sum += v;
+        }
+        sum
+    };
+    let force = [vr::ANCHOR_FORCE_X, vr::ANCHOR_FORCE_Y];
+    let force_torque = [vr::ANCHOR_FORCE_X, vr::ANCHOR_FORCE_Y, vr::ANCHOR_TORQUE_Z];
+    for (label, names, turning) in [("fmi3DoStep + anchorForce", &force[..], false), ("fmi3DoStep + anchorForce + anchorTorque", &force_torque[..], false), ("fmi3DoStep turning + anchorForce + anchorTorque", &force_torque[..], true)] {
+        group.bench_function(label, |b| {
+            b.iter_custom(|iters| {
+                let (mut event, mut terminate, mut early, mut last) = (false, false, false, 0.0);
+                let t = Instant::now();
+                for _ in 0..iters {
+                    if turning {
+                        // A slow turn back and forth: 0.1 rad at 1 rad/s.
+                        let angle = 0.1 * (time + dt).sin();
+                        assert_eq!(unsafe { fmi3SetFloat64(inst, &vr::ANCHOR_R_Z, 1, &angle, 1) }, fmi3Status_fmi3OK);
+                    }
+                    let status = unsafe { fmi3DoStep(inst, time, dt, true, &mut event, &mut terminate, &mut early, &mut last) };
+                    assert!(status == fmi3Status_fmi3OK || status == fmi3Status_fmi3Warning);
+                    assert!(read(names).is_finite());
+                    time += dt;
+                }
+                t.elapsed()
+            })
+        });
+    }
     group.finish();
     unsafe { fmi3FreeInstance(inst) };
 }

@@ -12,9 +12,10 @@ anchor="absolute" does the same, and the two conventions differ by
 round-off in B's coordinates.
 
 Implicit coupling (python/coupling.py) on the stiff pairs of 6 x 6 sheets
-(full space, 20 modes): it runs at h = 0.01 s, where both explicit orders
-are discarded, and converges to the limit of the explicit chain as h
-halves; where the explicit chain becomes stable.
+(full space, 20 modes): it runs at h = 0.01 s (full space) and 2^-6 s (20
+modes), where both explicit orders are discarded, and converges to the
+limit of the explicit chain as h halves; where the explicit chain becomes
+stable.
 
 Every tolerance below is derived from the numbers these tests print (run
 pytest with -s): the container runs are bit for bit the plain master with
@@ -258,11 +259,14 @@ def half_second_peaks(r):
 
 @pytest.mark.parametrize("sheets", STIFF)
 def test_implicit_chain_runs_where_the_explicit_chain_is_discarded(default_fmu, stiff, sheets):
-    """At h = 0.01 s both explicit orders grow until the FMU discards a step
-    (B's anchor would jump); both implicit chains run to the stop time, their
-    energy falls from one half second to the next, they agree with each other
-    to the tolerance, and IQN-ILS needs fewer iterations than Aitken."""
-    h = 0.01
+    """At h = 0.01 s (full space) and 2^-6 s (20 modes) both explicit orders
+    grow until the FMU discards a step (B's anchor would jump); both
+    implicit chains run to the stop time, their energy falls from one half
+    second to the next, they agree with each other to the tolerance, and
+    IQN-ILS needs fewer iterations than Aitken. (With 20 modes the explicit
+    Gauss-Seidel chain holds at 0.01 s: the damping's reaction in B's
+    holder force damps the interface.)"""
+    h = {"full": 0.01, "modes20": 2.0**-6}[sheets]
     for scheme in chain.EXPLICIT:
         with pytest.raises(chain.StepRefused, match=DISCARD) as refused:
             chain.run_master(default_fmu, h, STIFF_STOP, scheme=scheme, sheets=sheets)
@@ -313,10 +317,13 @@ def explicit_limit(stiff, sheets):
 
 @pytest.mark.parametrize("sheets", STIFF)
 def test_implicit_chain_converges_to_the_explicit_chain_at_small_steps(stiff, sheets):
-    """As h halves from 2^-6 s (coarser than the 0.01 s where the explicit
-    chain is discarded) the implicit chain tends to the limit of the
-    explicit chain: second order with A holding the mean of B's pull over
-    the step, first order with the pull at the end of the step."""
+    """As h halves from 2^-6 s (where the explicit chain is discarded) the
+    implicit chain tends to the limit of the explicit chain, at first order
+    with A holding the mean of B's pull over the step or the pull at its
+    end: B's pull is its holder's force, which carries the reaction of its
+    damping, and that jumps at every communication point with the anchor's
+    velocity (the first-order hold), so the mean of the two ends is no
+    better than one of them."""
     limit = explicit_limit(stiff, sheets)
     lines, ratios = [], {}
     for hold in ("mean", "end"):
@@ -328,20 +335,21 @@ def test_implicit_chain_converges_to_the_explicit_chain_at_small_steps(stiff, sh
             mean_errors = errors
     fine = stiff(sheets, "gauss-seidel", 2.0**-12)
     gs = coupling_error({k: fine[k][::2] for k in ["time"] + NODES}, limit)
+    same = stiff(sheets, "gauss-seidel", IMPLICIT_STEPS[-1])
+    at_h = coupling_error({k: same[k] for k in ["time"] + NODES}, limit)
     print(f"\n{sheets}, IQN-ILS against the explicit limit at h = 2^-6 ... 2^-9 s:\n  " + "\n  ".join(lines)
-          + f"\n  explicit Gauss-Seidel at 2^-12 s: {gs:.2e} m from the limit")
-    # measured 3.92 to 4.01 and 2.01 to 2.06
-    assert all(q > 3.5 for q in ratios["mean"]), ratios
-    assert all(1.8 < q < 2.3 for q in ratios["end"]), ratios
-    # measured 5.7e-5 and 3.8e-5 m at 2^-9 s, finer than the explicit chain at 2^-12 s (2.9e-4, 2.6e-4 m)
-    assert mean_errors[-1] < 0.5 * gs
+          + f"\n  explicit Gauss-Seidel at 2^-9 s: {at_h:.2e} m, at 2^-12 s: {gs:.2e} m from the limit")
+    # measured 2.06 to 2.24 (mean) and 2.04 to 2.17 (end)
+    for hold in ratios:
+        assert all(1.8 < q < 2.5 for q in ratios[hold]), ratios
+    assert mean_errors[-1] < at_h
 
 
 # The smallest power-of-two step at which each explicit order is still
 # unstable on each pair, over 3 s: a step discarded or energy that rises
 # from one half second to the next; at half of it the energy falls.
-EXPLICIT_LIMITS = {("full", "gauss-seidel"): 2.0**-8, ("full", "jacobi"): 2.0**-10,
-                   ("modes20", "gauss-seidel"): 2.0**-6, ("modes20", "jacobi"): 2.0**-9}
+EXPLICIT_LIMITS = {("full", "gauss-seidel"): 2.0**-7, ("full", "jacobi"): 2.0**-8,
+                   ("modes20", "gauss-seidel"): 2.0**-6, ("modes20", "jacobi"): 2.0**-7}
 
 
 @pytest.mark.parametrize("sheets,scheme", list(EXPLICIT_LIMITS), ids="-".join)
