@@ -161,7 +161,11 @@ fn do_step(c: &mut Criterion) {
     };
     let force = [vr::ANCHOR_FORCE_X, vr::ANCHOR_FORCE_Y];
     let force_torque = [vr::ANCHOR_FORCE_X, vr::ANCHOR_FORCE_Y, vr::ANCHOR_TORQUE_Z];
-    for (label, names, turning) in [("fmi3DoStep + anchorForce", &force[..], false), ("fmi3DoStep + anchorForce + anchorTorque", &force_torque[..], false), ("fmi3DoStep turning + anchorForce + anchorTorque", &force_torque[..], true)] {
+    for (label, names, turning) in [
+        ("fmi3DoStep + anchorForce", &force[..], false),
+        ("fmi3DoStep + anchorForce + anchorTorque", &force_torque[..], false),
+        ("fmi3DoStep turning + anchorForce + anchorTorque", &force_torque[..], true),
+    ] {
         group.bench_function(label, |b| {
             b.iter_custom(|iters| {
                 let (mut event, mut terminate, mut early, mut last) = (false, false, false, 0.0);

@@ -1,9 +1,9 @@
 //! The force and torque the sheet exerts on its holder (`anchorForce`,
 //! `anchorTorque`; `docs/method.md`, section 8), from the momentum balance:
 //! exact at rest whatever the basis, option and integrator; in full space
-//! the springs' pull on the held points at every instant; every mode kept,
-//! the full space's to round-off; a reduced basis prepared for the motion
-//! close to full space through a swing.
+//! the springs' pull on the held points and the damping's reaction at every
+//! instant; every mode kept, the full space's to round-off; a reduced basis
+//! prepared for the motion close to full space through a swing.
 
 use modal_mass_spring::physics::forces::pull;
 use modal_mass_spring::physics::frame::cross;
@@ -97,13 +97,18 @@ fn moment_of_loads(sim: &mut Simulator, a: [f64; 3]) -> [f64; 3] {
 }
 
 /// The force and torque (about the pivot) the springs exert on the points
-/// that ride with the holder: the held nodes and the points of the
-/// auxiliary springs, from the reported node positions (ground frame) and
-/// the anchor's displacement `a`. Independent of the momentum balance.
-fn springs_on_holder(sim: &mut Simulator, a: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+/// that ride with the holder (the held nodes and the points of the
+/// auxiliary springs) and the mass-proportional damping's reaction,
+/// alpha m (v - c) on every free node, from the reported node positions
+/// and velocities (ground frame), the anchor's displacement `a` and its
+/// velocity `c`. Independent of the momentum balance.
+fn springs_on_holder(sim: &mut Simulator, a: [f64; 3], c: [f64; 3]) -> ([f64; 3], [f64; 3]) {
     let scene = sim.scene().clone();
     let d = scene.dim;
+    let alpha = sim.loads().damping_alpha;
+    assert_eq!(sim.loads().damping_beta, 0.0);
     let positions = sim.positions().to_vec();
+    let velocities = sim.velocities().to_vec();
     let mut x: Vec<f64> = (0..scene.rest.len()).map(|k| scene.rest[k] + a[k % d]).collect();
     for (node, &slot) in scene.slot_of_node.iter().enumerate() {
         x[slot * d..slot * d + d].copy_from_slice(&positions[node * d..node * d + d]);
@@ -122,6 +127,18 @@ fn springs_on_holder(sim: &mut Simulator, a: [f64; 3]) -> ([f64; 3], [f64; 3]) {
             for i in 0..3 {
                 f[i] += p[i];
                 t[i] += m[i];
+            }
+        }
+    }
+    for (node, &slot) in scene.slot_of_node.iter().enumerate() {
+        if slot < scene.n_free {
+            let m = scene.dof_mass[slot * d];
+            let drag: [f64; 3] = std::array::from_fn(|i| if i < d { alpha * m * (velocities[node * d + i] - c[i]) } else { 0.0 });
+            let arm: [f64; 3] = std::array::from_fn(|i| if i < d { positions[node * d + i] - pivot[i] - a[i] } else { 0.0 });
+            let moment = cross(&arm, &drag);
+            for i in 0..3 {
+                f[i] += drag[i];
+                t[i] += moment[i];
             }
         }
     }
@@ -168,17 +185,18 @@ fn swing_run(sim: &mut Simulator, steps: usize, springs: bool) -> Vec<[[f64; 3];
     for k in 0..steps {
         let mut loads = sim.loads().clone();
         let a = swing((k + 1) as f64 * 0.01);
+        let c: [f64; 3] = std::array::from_fn(|i| (a[i] - loads.anchor[i]) / 0.01);
         loads.anchor = a;
         sim.set_loads(&loads).unwrap();
         sim.do_step(0.01).unwrap();
-        let (f, t) = if springs { springs_on_holder(sim, a) } else { ([0.0; 3], [0.0; 3]) };
+        let (f, t) = if springs { springs_on_holder(sim, a, c) } else { ([0.0; 3], [0.0; 3]) };
         out.push([sim.anchor_force(), sim.anchor_torque(), f, t]);
     }
     out
 }
 
 #[test]
-fn in_full_space_the_holder_gets_the_springs_pull_at_every_instant() {
+fn in_full_space_the_holder_gets_the_springs_pull_and_the_dampings_reaction_at_every_instant() {
     for scene in ["paper-2d-top-row", "paper-3d-sheet"] {
         for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit] {
             let mut sim = simulator(scene, settings(Reduction::Full, integrator, 0), 1.0);

@@ -22,7 +22,16 @@ fn simulator(p: &Grid, s: &Settings, loads: &Loads) -> Simulator {
 /// A state from the concatenation [y, y', y''].
 fn state(flat: Vec<f64>) -> State {
     let n = flat.len() / 3;
-    State { time: 0.0, y: flat[..n].to_vec(), v: flat[n..2 * n].to_vec(), a: flat[2 * n..].to_vec(), anchor: [0.0; 3], anchor_rate: [0.0; 3], rotation: [0.0; 3], spin: [0.0; 3] }
+    State {
+        time: 0.0,
+        y: flat[..n].to_vec(),
+        v: flat[n..2 * n].to_vec(),
+        a: flat[2 * n..].to_vec(),
+        anchor: [0.0; 3],
+        anchor_rate: [0.0; 3],
+        rotation: [0.0; 3],
+        spin: [0.0; 3],
+    }
 }
 
 fn basis(p: &Grid, r: usize) -> (Scene, StiffnessPattern, Vec<f64>, ModalBasis) {

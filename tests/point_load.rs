@@ -137,12 +137,13 @@ fn the_point_load_alone_is_a_load_pattern() {
     setup.loads.point_load = LOAD;
     setup.loads.damping_alpha = ALPHA;
     let mut sim = setup.simulator().unwrap();
-    for _ in 0..200 {
+    for _ in 0..2000 {
         sim.do_step(0.01).unwrap();
     }
-    // Linearized at the equilibrium under the point load, the run starts at rest away from it and settles there.
+    // Linearized at the equilibrium under the point load, the run starts at rest away from it and settles
+    // there, where the holder carries the load alone (gravity is zero).
     let f = sim.anchor_force();
-    assert!((f[0] - LOAD[0]).abs() < 1e-3 && (f[1] - LOAD[1]).abs() < 1e-3, "anchor force {f:?}");
+    assert!((f[0] - LOAD[0]).abs() < 1e-9 && (f[1] - LOAD[1]).abs() < 1e-9, "anchor force {f:?}");
 }
 
 // ---- through the C ABI ----

@@ -53,8 +53,8 @@ const CACHE: usize = 11;
 /// A step along which the filtered rest is stiffer than that is refused.
 pub const MAX_REST_STIFFNESS: f64 = 4.0;
 
-/// Relative change of the filtered rest along a step below which it is
-/// round-off (a few thousand ulps), not a stiffening the kicks must follow.
+/// Relative change of the coordinates along a step below which it is
+/// round-off (a few thousand ulps), along which no stiffening is measured.
 const REST_ROUND_OFF: f64 = 1e-12;
 
 impl Scheme for Trigonometric {
@@ -96,20 +96,21 @@ impl Scheme for Trigonometric {
         space.force(loads, &buf.a1, w, &mut buf.h);
         let d = diagonal(space, w);
         // The secant stiffness of the filtered rest along the step, |psi (e1 - e0)| / |y1 - y0|.
-        let (mut de, mut dy, mut size) = (0.0, 0.0, 0.0);
+        let scale = space.layout().newton_scale;
+        let (mut de, mut dy, mut size) = (0.0, 0.0, scale * scale);
         for i in 0..state.y.len() {
             let e = buf.h[i] + d.stiffness[i] * buf.a1[i] - d.load[i];
             // filter * kick (the cache's values 8 and 9) = sinc(xi) psi_1(xi).
             let psi = buf.scheme[i * CACHE + 8] * buf.scheme[i * CACHE + 9];
             de += (psi * (e - state.a[i])).powi(2);
             dy += (buf.y1[i] - state.y[i]).powi(2);
-            size += (psi * e).powi(2);
+            size += buf.y1[i] * buf.y1[i];
             buf.v1[i] += buf.r[i] * e;
             state.a[i] = e;
         }
-        // At rest both changes are round-off, and so is their ratio: a change of
-        // the rest below REST_ROUND_OFF of its size is no stiffening.
-        if dt * dt * de.sqrt() > MAX_REST_STIFFNESS * dy.sqrt() && de > REST_ROUND_OFF * REST_ROUND_OFF * size {
+        // e depends on y alone: where y moved by round-off of its size or of
+        // the scene's (at rest), so did e, and their ratio is no stiffness.
+        if dt * dt * de.sqrt() > MAX_REST_STIFFNESS * dy.sqrt() && dy > REST_ROUND_OFF * REST_ROUND_OFF * size {
             return Err(StepFailure::RestTooStiff { stiffness: (de / dy).sqrt(), limit: MAX_REST_STIFFNESS / (dt * dt), dt });
         }
         std::mem::swap(&mut state.y, &mut buf.y1);
@@ -202,14 +203,18 @@ pub const EPSILON: f64 = 0.3;
 /// and the filters of the rest of the force at xi = dt sqrt(lambda): it is
 /// evaluated at `filter` y, filter = phi(xi) = sinc(xi), and kicks the rates
 /// by dt/2 `kick` e, kick = psi_1(xi) = sinc(xi/2) cos(xi/2) / (cos^2(xi/2) + EPSILON^2 sin^2(xi/2)),
-/// so that sinc(xi) psi_1(xi) = sinc^2(xi/2) chi(xi). The closing kick is
-/// dt/2 `kick_end` e with kick_end = kick (P^2 / I - V_v): with a constant
-/// rest e the step then has the rest of y'' + c y' + lambda y = b + kappa e,
-/// kappa = P dt kick / (2 I), at zero rate (the position update asks
-/// lambda I y = I b + P dt/2 kick e, the rate update
-/// lambda P y = P b + (V_v kick + kick_end) dt/2 e). Undamped,
-/// P^2 = I (1 + V_v) and kick_end = kick; with equal kicks a damped sheet
-/// would settle at a position with a spurious rate, of order c dt^2 e.
+/// so that sinc(xi) psi_1(xi) = sinc^2(xi/2) chi(xi). Written with the
+/// propagator's own P and I, dt/2 kick = P I / (P^2 + EPSILON^2 lambda I^2)
+/// = chi I / P (undamped P^2 = 2 I cos^2(xi/2), lambda I^2 = 2 I sin^2(xi/2)).
+/// Damped (c > 0), the kicks take that form, and the closing one
+/// dt/2 `kick_end` = (P^2 - V_v I) P / (P^2 + EPSILON^2 lambda I^2): with a
+/// constant rest e the step then keeps y'' + c y' + lambda y = b + kappa e,
+/// kappa = P^2 / (P^2 + EPSILON^2 lambda I^2) (chi undamped), at zero rate
+/// (the position update asks lambda I y = I b + P dt/2 kick e, the rate
+/// update lambda P y = P b + (V_v kick + kick_end) dt/2 e), and neither
+/// has a pole where the damped P vanishes. Undamped, P^2 = I (1 + V_v) and
+/// kick_end = kick. Equal kicks of the undamped form would leave a damped
+/// sheet at rest with a spurious rate, of order c dt^2 e.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Propagator {
     pub yy: f64,
@@ -229,10 +234,14 @@ impl Propagator {
         let s = u.s * dt;
         let x = xi(lambda, dt);
         let (sin, cos) = (0.5 * x).sin_cos();
-        let kick = sinc(0.5 * x) * cos / (cos * cos + EPSILON * EPSILON * sin * sin);
         let yg = u.i * dt * dt;
-        // Undamped the ratio is 1: kept exact so undamped runs do not depend on its round-off.
-        let kick_end = if c == 0.0 { kick } else { kick * (s * s / yg - u.ds) };
+        let (kick, kick_end) = if c == 0.0 {
+            let kick = sinc(0.5 * x) * cos / (cos * cos + EPSILON * EPSILON * sin * sin);
+            (kick, kick)
+        } else {
+            let den = 0.5 * dt * (s * s + EPSILON * EPSILON * lambda * yg * yg);
+            (s * yg / den, (s * s - u.ds * yg) * s / den)
+        };
         Propagator { yy: u.yy, yv: s, yg, vy: -lambda * s, vv: u.ds, filter: sinc(x), kick, kick_end }
     }
 }
