@@ -11,7 +11,12 @@
 //!   every spring);
 //! - `do_step/paper-2d-top-row`: a communication step of one internal step,
 //!   through `Simulator::do_step` and through `fmi3DoStep` of the C ABI, beside
-//!   the internal step alone: the differences are the overheads of a call.
+//!   the internal step alone: the differences are the overheads of a call;
+//!   and the same with the holder's force, and torque, read after each step,
+//!   and with the holder turning;
+//! - `residual_check/cloth-3d-NxN`: `fmi3DoStep` of the cloth with 16 modes
+//!   of the load, a static correction and cubature forces, as a host gets it
+//!   (the default `forceResidualLimit`) and with the check off, 0.01 s steps.
 //!
 //! cargo bench --bench step
 
@@ -189,9 +194,60 @@ fn do_step(c: &mut Criterion) {
     unsafe { fmi3FreeInstance(inst) };
 }
 
+/// An instance of the cloth-3d scene on an n x n grid with 16 modes of the
+/// load, a static correction and cubature forces, `limit` its
+/// forceResidualLimit, initialized at t = 0.
+fn cloth_instance(n: u64, limit: f64) -> fmi3Instance {
+    let (name, token) = (CString::new("bench").unwrap(), CString::new(INSTANTIATION_TOKEN).unwrap());
+    let inst = unsafe { fmi3InstantiateCoSimulation(name.as_ptr(), token.as_ptr(), null(), false, false, false, false, null(), 0, null_mut(), Some(silent), None) };
+    assert!(!inst.is_null());
+    let ok = fmi3Status_fmi3OK;
+    let on = true;
+    unsafe {
+        for (r, v) in [(vr::NX, n), (vr::NY, n), (vr::DIMENSION, 3), (vr::N_MODES, 16), (vr::LOAD_COLUMN, n / 2)] {
+            assert_eq!(fmi3SetUInt64(inst, &r, 1, &v, 1), ok);
+        }
+        for (r, v) in [(vr::MODE_SELECTION, 2i64), (vr::FORCE_EVALUATION, 2)] {
+            assert_eq!(fmi3SetInt64(inst, &r, 1, &v, 1), ok);
+        }
+        assert_eq!(fmi3SetBoolean(inst, &vr::STATIC_CORRECTION, 1, &on, 1), ok);
+        for (r, v) in [(vr::AUX_STIFFNESS, 0.05), (vr::FORCE_RESIDUAL_LIMIT, limit)] {
+            assert_eq!(fmi3SetFloat64(inst, &r, 1, &v, 1), ok);
+        }
+        assert_eq!(fmi3EnterInitializationMode(inst, false, 0.0, 0.0, false, 0.0), ok);
+        assert_eq!(fmi3ExitInitializationMode(inst), ok);
+    }
+    inst
+}
+
+fn residual_check(c: &mut Criterion) {
+    for n in [30u64, 100] {
+        let mut group = c.benchmark_group(format!("residual_check/cloth-3d-{n}x{n}"));
+        group.sample_size(20);
+        for (label, limit) in [("default forceResidualLimit", 0.9), ("check off", 0.0)] {
+            let inst = cloth_instance(n, limit);
+            let (h, mut time) = (0.01, 0.0);
+            group.bench_function(label, |b| {
+                b.iter_custom(|iters| {
+                    let (mut event, mut terminate, mut early, mut last) = (false, false, false, 0.0);
+                    let t = Instant::now();
+                    for _ in 0..iters {
+                        let status = unsafe { fmi3DoStep(inst, time, h, true, &mut event, &mut terminate, &mut early, &mut last) };
+                        assert!(status == fmi3Status_fmi3OK || status == fmi3Status_fmi3Warning);
+                        time += h;
+                    }
+                    t.elapsed()
+                })
+            });
+            unsafe { fmi3FreeInstance(inst) };
+        }
+        group.finish();
+    }
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(2));
-    targets = do_step, internal_step, cubature
+    targets = do_step, internal_step, cubature, residual_check
 }
 criterion_main!(benches);

@@ -284,3 +284,44 @@ fn force_residual_rises_when_the_scene_leaves_the_basis() {
     full.run(10, 0.01);
     assert_eq!(residual(&full), 0.0);
 }
+
+/// With cubature forces the steps visit a few springs and a residual check
+/// visits them all: the check runs after the first step, after every change
+/// of the loads and otherwise every `residual_period` steps, a tenth of the
+/// steps' own spring visits at most. Gravity turned sideways is caught at
+/// the very next step, as with exact forces.
+#[test]
+fn with_cubature_the_residual_check_runs_after_a_load_change_and_every_few_steps() {
+    let f = Fmu::new();
+    assert_eq!(f.set_u64(vr::N_MODES, 8), OK);
+    assert_eq!(f.set_i64(vr::MODE_SELECTION, 2), OK);
+    assert_eq!(f.set_i64(vr::FORCE_EVALUATION, 2), OK);
+    let on: bool = true;
+    assert_eq!(unsafe { modal_mass_spring::fmi::exports::fmi3SetBoolean(f.inst, &vr::STATIC_CORRECTION, 1, &on, 1) }, OK);
+    f.init();
+    for _ in 0..50 {
+        assert_eq!(f.step(f.time(), 0.01), OK, "{:?}", f.messages());
+    }
+    // Gravity turned along x, which the basis (built for gravity along -y) holds none of.
+    assert_eq!(f.set_f64(vr::GRAVITY, &[9.81, 0.0, 0.0]), OK);
+    assert_eq!(f.step(f.time(), 0.01), WARNING, "the step after the change of gravity is checked: {:?}", f.messages());
+    // The period: every spring against the springs one step visits.
+    let mut solver = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 8);
+    solver.mode_selection = ModeSelection::Load;
+    solver.static_correction = true;
+    solver.force_evaluation = ForceEvaluation::Cubature;
+    let mut sim = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver.clone()).simulator().unwrap();
+    sim.do_step(0.01).unwrap();
+    let (all, visited) = (sim.scene().springs.len(), sim.cubature_springs() * sim.internal_steps_last());
+    let period = modal_mass_spring::model::residual_period(&sim);
+    println!("cubature: {visited} spring visits a step of {all} springs: a check every {period} steps");
+    assert!(visited < all && period > 1);
+    assert_eq!(period, (all as f64 / (0.1 * visited as f64)).ceil() as u64);
+    // Exact forces and full space visit every spring each step: a check after every step.
+    for (reduction, evaluation) in [(Reduction::Modal, ForceEvaluation::Exact), (Reduction::Full, ForceEvaluation::Exact)] {
+        let s = Settings { reduction, force_evaluation: evaluation, ..solver.clone() };
+        let mut sim = scenes::canonical("paper-2d-top-row").unwrap().with_settings(s).simulator().unwrap();
+        sim.do_step(0.01).unwrap();
+        assert_eq!(modal_mass_spring::model::residual_period(&sim), 1, "{reduction:?}");
+    }
+}

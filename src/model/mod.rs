@@ -37,6 +37,12 @@ pub struct MassSpring {
     baked: Option<Vec<u8>>,
     /// forceResidual passed forceResidualLimit once, and the host was told.
     residual_warned: bool,
+    /// The residual check is due after the next step (a new simulator, new
+    /// loads, a restored state); the steps taken since the last check, and
+    /// the steps to the next one, doubled after every check up to [`residual_period`].
+    residual_due: bool,
+    residual_wait: u64,
+    residual_gap: u64,
     /// The host set loadColumn; until then it follows the middle of the row (nx / 2).
     load_column_chosen: bool,
     /// Scratch for the loads handed to the simulator, filled in place and
@@ -55,6 +61,9 @@ impl Model for MassSpring {
             stale: true,
             baked: resources.and_then(|dir| std::fs::read(dir.join(bake::FILE)).ok()),
             residual_warned: false,
+            residual_due: true,
+            residual_wait: 0,
+            residual_gap: 1,
             load_column_chosen: false,
             loads: Params::start().loads(),
             springs: None,
@@ -65,6 +74,7 @@ impl Model for MassSpring {
         self.sim = None;
         self.stale = true;
         self.residual_warned = false;
+        self.residual_due = true;
         self.load_column_chosen = false;
         self.springs = None;
     }
@@ -127,6 +137,8 @@ impl Model for MassSpring {
             p.fill_loads(&mut self.loads);
             let sim = self.sim.as_mut().expect("Step Mode has a simulator");
             sim.set_loads(&self.loads).map_err(|e| messages::describe(&e, p))?;
+            // New loads (gravity turned sideways, a point load) are checked after the next step.
+            self.residual_due = true;
         } else {
             self.stale = true;
         }
@@ -163,9 +175,22 @@ impl Model for MassSpring {
         if let Err(e) = sim.do_step(h) {
             return Err(messages::describe(&e, p));
         }
-        // The check costs one pass over every spring; a limit of 0 turns it off.
+        // A check costs one pass over every spring; a limit of 0 turns it off.
         let limit = p.scalar(vr::FORCE_RESIDUAL_LIMIT);
-        let residual = if self.residual_warned || limit <= 0.0 { 0.0 } else { sim.force_residual() };
+        if self.residual_warned || limit <= 0.0 {
+            return Ok(StepEnd::Done);
+        }
+        self.residual_wait += 1;
+        if self.residual_due {
+            // After a change the scene leaves the basis soonest: checks 1, 2, 4, ... steps apart.
+            self.residual_gap = 1;
+        } else if self.residual_wait < self.residual_gap {
+            return Ok(StepEnd::Done);
+        }
+        self.residual_due = false;
+        self.residual_wait = 0;
+        self.residual_gap = (2 * self.residual_gap).min(residual_period(sim));
+        let residual = sim.force_residual();
         if residual > limit {
             self.residual_warned = true;
             let end = time0 + sim.time();
@@ -212,6 +237,9 @@ impl Model for MassSpring {
             self.installed(sim, p);
         }
         self.stale = false;
+        // A restored state is checked after the next step.
+        self.residual_due = true;
+        self.residual_wait = 0;
         Ok(())
     }
 
@@ -231,6 +259,27 @@ impl Model for MassSpring {
     }
 }
 
+/// The share of a run's cost the residual check may take.
+pub const RESIDUAL_CHECK_SHARE: f64 = 0.1;
+
+/// Communication steps between two residual checks, once the scene has
+/// run a while since its last change: a check visits every spring once, a
+/// step the springs of its force evaluations (every spring, or the
+/// cubature set, per internal step); checking every `period` steps keeps
+/// the check's share at [`RESIDUAL_CHECK_SHARE`] of the steps' own spring
+/// visits. 1 where the steps visit every spring anyway. After a change the
+/// checks come 1, 2, 4, ... steps apart up to it: about log2(period) more
+/// checks per change.
+pub fn residual_period(sim: &Simulator) -> u64 {
+    let all = sim.scene().springs.len() as f64;
+    let visited = (sim.cubature_springs() * sim.internal_steps_last().max(1)) as f64;
+    if visited >= all {
+        1
+    } else {
+        (all / (RESIDUAL_CHECK_SHARE * visited)).ceil() as u64
+    }
+}
+
 impl MassSpring {
     /// Makes `sim`, set up from `p`, the current simulator (and sizes the
     /// loads' scratch for it).
@@ -239,6 +288,8 @@ impl MassSpring {
         self.sim = Some(sim);
         self.stale = false;
         self.springs = None;
+        self.residual_due = true;
+        self.residual_wait = 0;
     }
 
     /// The springs between two nodes of the scene (auxiliary springs, tied
