@@ -199,7 +199,8 @@ fn do_step(c: &mut Criterion) {
 /// forceResidualLimit, initialized at t = 0.
 fn cloth_instance(n: u64, limit: f64) -> fmi3Instance {
     let (name, token) = (CString::new("bench").unwrap(), CString::new(INSTANTIATION_TOKEN).unwrap());
-    let inst = unsafe { fmi3InstantiateCoSimulation(name.as_ptr(), token.as_ptr(), null(), false, false, false, false, null(), 0, null_mut(), Some(silent), None) };
+    let inst =
+        unsafe { fmi3InstantiateCoSimulation(name.as_ptr(), token.as_ptr(), null(), false, false, false, false, null(), 0, null_mut(), Some(silent), None) };
     assert!(!inst.is_null());
     let ok = fmi3Status_fmi3OK;
     let on = true;

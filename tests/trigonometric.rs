@@ -10,7 +10,7 @@ mod common;
 
 use common::*;
 use modal_mass_spring::fmi::variables::vr;
-use modal_mass_spring::physics::engine::{Engine, Stepper};
+use modal_mass_spring::physics::engine::{Engine, Probe, Stepper};
 use modal_mass_spring::physics::error::StepFailure;
 use modal_mass_spring::physics::frame::{Frame, Moments};
 use modal_mass_spring::physics::integrator::{Propagator, Trigonometric};
@@ -151,6 +151,8 @@ struct Linear {
     /// Generalized load before the weights.
     load: Vec<f64>,
     frequencies: Vec<f64>,
+    /// Force evaluations so far.
+    evaluations: std::cell::Cell<usize>,
 }
 
 struct LinearWork {
@@ -161,7 +163,13 @@ struct LinearWork {
 impl Linear {
     fn new(lambda: &[f64], load: &[f64]) -> Self {
         let scene = Scene { dim: 2, n_nodes: 1, n_free: 1, slot_of_node: vec![0], rest: vec![0.0, 0.0], dof_mass: vec![1.0, 1.0], springs: vec![] };
-        Linear { scene, lambda: lambda.to_vec(), load: load.to_vec(), frequencies: lambda.iter().map(|l| l.sqrt()).collect() }
+        Linear {
+            scene,
+            lambda: lambda.to_vec(),
+            load: load.to_vec(),
+            frequencies: lambda.iter().map(|l| l.sqrt()).collect(),
+            evaluations: std::cell::Cell::new(0),
+        }
     }
 }
 
@@ -187,6 +195,7 @@ impl Space for Linear {
         }
     }
     fn force(&self, _loads: &Loads, y: &[f64], w: &mut LinearWork, h: &mut [f64]) {
+        self.evaluations.set(self.evaluations.get() + 1);
         for i in 0..y.len() {
             h[i] = w.load[i] - self.lambda[i] * y[i];
         }
@@ -278,7 +287,6 @@ fn linear_run(loads: &Loads, y0: &[f64], v0: &[f64], dt: f64, steps: usize) -> V
     let mut out = Vec::new();
     for _ in 0..steps {
         engine.step(loads, &mut state, dt).unwrap();
-        engine.finish(loads, &state);
         out.push((state.y.clone(), state.v.clone()));
     }
     out
@@ -649,4 +657,28 @@ fn refused_in_full_space() {
     let message = f.messages().last().cloned().unwrap_or_default();
     assert!(message.contains("integrator = trigonometric") && message.contains("reduction = modal") && message.contains("reduction = full"), "{message}");
     f.expect_error(status, "trigonometric in full space");
+}
+
+/// One force evaluation per internal step, at the filtered coordinates:
+/// the forces at the state are evaluated once, when an output first needs
+/// them (here the potential energy), and the step guard's energy needs none.
+#[test]
+fn one_force_evaluation_per_step_until_an_output_needs_the_forces() {
+    let loads = linear_loads(0.5, 1e-3, &[1.0; 5]);
+    let mut engine = Engine::<Linear, Trigonometric>::new(Linear::new(&LAMBDA, &LOAD)).unwrap();
+    engine.apply_loads(&loads);
+    let mut state = State::at_rest(LAMBDA.len());
+    engine.settle(&loads, &mut state);
+    engine.step(&loads, &mut state, 0.01).unwrap();
+    let count = |e: &Engine<Linear, Trigonometric>| e.space().evaluations.get();
+    let start = count(&engine);
+    for _ in 0..10 {
+        engine.step(&loads, &mut state, 0.01).unwrap();
+        assert!(engine.model_energy(&loads, &state).is_finite());
+    }
+    assert_eq!(count(&engine) - start, 10, "one evaluation per step, none for the guard");
+    let e1 = engine.potential_energy(&loads, &state);
+    assert_eq!(count(&engine) - start, 11, "the potential energy evaluates the forces at the state");
+    let e2 = engine.potential_energy(&loads, &state);
+    assert_eq!((count(&engine) - start, e1), (11, e2), "and only once");
 }

@@ -81,9 +81,6 @@ pub trait Stepper: Probe + Send {
     fn evaluate(&mut self, loads: &Loads, state: &State);
     /// One internal step of length `dt`.
     fn step(&mut self, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure>;
-    /// After the internal steps of a communication step: the forces
-    /// evaluated at `state.y` (see [`Scheme::finish`]).
-    fn finish(&mut self, loads: &Loads, state: &State);
     /// Adds the rates of a rigid translation with velocity `c` and of a
     /// rigid rotation about the pivot with angular velocity `spin` to
     /// `state.v` (see [`Space::add_translation_rate`],
@@ -109,13 +106,15 @@ pub trait Probe {
     /// Kinetic energy of `state` [J].
     fn kinetic_energy(&self, state: &State) -> f64;
     /// Potential energy of `state` as the force model sums it (see
-    /// [`Readout::model_energy`]), for the step guard [J].
+    /// [`Readout::model_energy`]), for the step guard, at the coordinates of
+    /// the last force evaluation (the state's, or the trigonometric scheme's
+    /// filtered ones: see [`Scheme::ENDS_AT_STATE`]) [J].
     fn model_energy(&mut self, loads: &Loads, state: &State) -> f64;
     /// Coordinates of the kept or reported modes.
     fn modal_coordinates(&self, state: &State, out: &mut [f64]);
     /// Node positions of `state` (whose forces were evaluated last) into
     /// `out.positions`.
-    fn node_positions(&mut self, state: &State, out: &mut Outputs);
+    fn node_positions(&mut self, loads: &Loads, state: &State, out: &mut Outputs);
     /// Node velocities of `state` into `out.velocities` (held nodes at 0).
     fn node_velocities(&mut self, state: &State, out: &mut Outputs);
     /// Position of one node of `state` (whose forces were evaluated last),
@@ -135,7 +134,7 @@ pub trait Probe {
     /// (see [`Readout::moments`]).
     fn moments(&mut self, state: &State) -> (Moments, Moments);
     /// Elastic energy of every spring at `state` (whose forces were evaluated last) [J].
-    fn elastic_energy(&mut self, state: &State) -> f64;
+    fn elastic_energy(&mut self, loads: &Loads, state: &State) -> f64;
     /// Elastic energy of every spring plus gravity potential at `state` [J].
     fn potential_energy(&mut self, loads: &Loads, state: &State) -> f64;
     /// The force the space cannot represent at `state`, relative to the load.
@@ -193,6 +192,8 @@ pub struct Engine<S: Readout, I: Scheme> {
     buffers: Buffers,
     /// y'' of the scheme's motion, for the holder's force and torque.
     acceleration: Vec<f64>,
+    /// The forces of `work` are those at the state's coordinates (see [`Scheme::ENDS_AT_STATE`]).
+    current: bool,
     scheme: PhantomData<I>,
 }
 
@@ -202,7 +203,20 @@ impl<S: Readout, I: Scheme> Engine<S, I> {
         let work = space.work();
         I::check(&space, &work)?;
         let n = space.layout().coordinates;
-        Ok(Engine { work, buffers: Buffers::new(n, I::SCRATCH), acceleration: vec![0.0; n], space, scheme: PhantomData })
+        Ok(Engine { work, buffers: Buffers::new(n, I::SCRATCH), acceleration: vec![0.0; n], current: false, space, scheme: PhantomData })
+    }
+
+    /// The space the engine steps.
+    pub fn space(&self) -> &S {
+        &self.space
+    }
+
+    /// The forces of `work` at `state.y`, evaluated if the last step left them elsewhere.
+    fn current(&mut self, loads: &Loads, state: &State) {
+        if !self.current {
+            self.space.force(loads, &state.y, &mut self.work, &mut self.buffers.h);
+            self.current = true;
+        }
     }
 
     /// y'' of the scheme's motion at `state` into `self.acceleration`.
@@ -242,20 +256,19 @@ impl<S: Readout, I: Scheme> Stepper for Engine<S, I> {
 
     fn settle(&mut self, loads: &Loads, state: &mut State) {
         I::settle(&self.space, &mut self.work, &mut self.buffers, loads, state);
+        self.current = true;
     }
 
     fn evaluate(&mut self, loads: &Loads, state: &State) {
         self.space.force(loads, &state.y, &mut self.work, &mut self.buffers.h);
+        self.current = true;
         // A restored state.a was derived for a step size the buffers do not know.
         self.buffers.filter_step = f64::NAN;
     }
 
     fn step(&mut self, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure> {
+        self.current = I::ENDS_AT_STATE;
         I::step(&self.space, &mut self.work, &mut self.buffers, loads, state, dt)
-    }
-
-    fn finish(&mut self, loads: &Loads, state: &State) {
-        I::finish(&self.space, &mut self.work, &mut self.buffers, loads, state);
     }
 
     fn kick(&mut self, loads: &Loads, c: &[f64; 3], spin: &[f64; 3], state: &mut State) {
@@ -296,14 +309,16 @@ impl<S: Readout, I: Scheme> Probe for Engine<S, I> {
     }
 
     fn model_energy(&mut self, loads: &Loads, state: &State) -> f64 {
-        self.space.model_energy(loads, &state.y, &mut self.work)
+        let at = if self.current { &state.y } else { &self.buffers.a1 };
+        self.space.model_energy(loads, at, &mut self.work)
     }
 
     fn modal_coordinates(&self, state: &State, out: &mut [f64]) {
         self.space.modal_coordinates(&state.y, out);
     }
 
-    fn node_positions(&mut self, state: &State, out: &mut Outputs) {
+    fn node_positions(&mut self, loads: &Loads, state: &State, out: &mut Outputs) {
+        self.current(loads, state);
         let scene = self.space.scene();
         let x = self.space.positions(&state.y, &mut self.work);
         match scene.dim {
@@ -349,15 +364,18 @@ impl<S: Readout, I: Scheme> Probe for Engine<S, I> {
         (self.space.moments(&state.y, &state.v), self.space.moments(&state.y, &self.acceleration))
     }
 
-    fn elastic_energy(&mut self, state: &State) -> f64 {
+    fn elastic_energy(&mut self, loads: &Loads, state: &State) -> f64 {
+        self.current(loads, state);
         self.space.elastic_energy(&state.y, &mut self.work)
     }
 
     fn potential_energy(&mut self, loads: &Loads, state: &State) -> f64 {
+        self.current(loads, state);
         self.space.elastic_energy(&state.y, &mut self.work) + self.space.gravity_potential(loads, &state.y, &self.work)
     }
 
     fn force_residual(&mut self, loads: &Loads, state: &State) -> f64 {
+        self.current(loads, state);
         self.space.force_residual(loads, &state.y, &mut self.work)
     }
 }

@@ -247,9 +247,6 @@ impl Simulator {
                 break;
             }
         }
-        if result.is_ok() {
-            self.engine.finish(&self.loads, &self.state);
-        }
         // A spinning frame can give the sheet the kinetic energy of its far end at the frame's speed.
         let spun = self.free_mass * (norm(&spin) * self.arm).powi(2) * self.loads.weight_max().powi(2);
         if let Err(cause) = result.and_then(|_| self.check_state(dt, energy_before + spun)) {
@@ -359,7 +356,7 @@ impl Simulator {
     /// asked after a step.
     pub fn positions(&mut self) -> &[f64] {
         if !self.fresh.positions {
-            self.engine.node_positions(&self.state, &mut self.outputs);
+            self.engine.node_positions(&self.loads, &self.state, &mut self.outputs);
             if self.turned() {
                 self.outputs.frame_positions.copy_from_slice(&self.outputs.positions);
                 let (r, d, a) = (rotation(&self.state.rotation), self.scene().dim, self.state.anchor);
@@ -522,7 +519,7 @@ impl Simulator {
         if !self.fresh.potential && self.turned() {
             // Elastic energy, and -g . sum m (X - X_rest) = -g . (m a + R S - S_rest), and -f_p . (X_p - X_p,rest).
             let (d, point) = (self.scene().dim, point_load(&self.loads, self.scene()));
-            let elastic = self.engine.elastic_energy(&self.state);
+            let elastic = self.engine.elastic_energy(&self.loads, &self.state);
             let s = apply(&rotation(&self.state.rotation), &self.engine.first_moment(&self.state));
             let g: [f64; 3] = std::array::from_fn(|i| if i < d { self.loads.gravity[i] } else { 0.0 });
             let lowered: [f64; 3] = std::array::from_fn(|i| self.free_mass * self.state.anchor[i] + s[i] - self.rest_moment[i]);

@@ -55,10 +55,13 @@ pub trait Scheme: Send + 'static {
         out.copy_from_slice(&state.a);
     }
 
-    /// After the internal steps of a communication step: leaves the forces
-    /// of `w` evaluated at `state.y`, where the outputs and the step guard
-    /// read them. Nothing for a scheme whose last evaluation is there.
-    fn finish<S: Space>(_space: &S, _w: &mut S::Work, _buf: &mut Buffers, _loads: &Loads, _state: &State) {}
+    /// The last force evaluation of a step is at the new coordinates, where
+    /// the outputs read the forces (Newmark). Otherwise (the trigonometric
+    /// scheme, whose last evaluation is at the filtered coordinates in
+    /// `Buffers::a1`) the forces at the state are evaluated only when an
+    /// output needs them, and the step guard weighs the potential energy at
+    /// the coordinates of that last evaluation.
+    const ENDS_AT_STATE: bool = true;
 }
 
 /// Vectors of the generalized coordinates' length that a step works in.

@@ -61,6 +61,8 @@ impl Scheme for Trigonometric {
     const SCRATCH: usize = CACHE;
     /// Its kicks take forces of the positions alone.
     const TURNS: bool = false;
+    /// The step's evaluation is at phi y (in `buf.a1`); the outputs evaluate at y when read.
+    const ENDS_AT_STATE: bool = false;
 
     /// The linear part is integrated exactly: no limit.
     fn stable_step(_omega_sq_max: f64) -> Option<f64> {
@@ -148,11 +150,6 @@ impl Scheme for Trigonometric {
                 buf.h[i] - c * state.v[i]
             };
         }
-    }
-
-    /// The step's evaluation is at phi y: once more at y for the outputs.
-    fn finish<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, loads: &Loads, state: &State) {
-        space.force(loads, &state.y, w, &mut buf.h);
     }
 }
 
