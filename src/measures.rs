@@ -65,6 +65,19 @@ pub fn trajectory_error<R: AsRef<[f64]>, Q: AsRef<[f64]>>(run: &[R], reference: 
     trajectory_errors_by_window(run, reference, start, masses).last().copied().unwrap_or(f64::NAN)
 }
 
+/// The predictability horizon of a scene from its twins (`docs/method.md`,
+/// section 6): each element of `twins` is E over growing windows
+/// ([`trajectory_errors_by_window`]) of a run started a hair away from the
+/// reference, at the output `times`; the horizon is the earliest time at
+/// which any twin's E reaches `threshold`, `None` when none does within the
+/// run. The twins' floor at the end is the largest last E.
+pub fn predictability(times: &[f64], twins: &[Vec<f64>], threshold: f64) -> (Option<f64>, f64) {
+    let horizon =
+        twins.iter().filter_map(|e| e.iter().position(|&x| x >= threshold).map(|k| times[k])).fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.min(t))));
+    let floor = twins.iter().filter_map(|e| e.last().copied()).fold(0.0, f64::max);
+    (horizon, floor)
+}
+
 /// The largest distance between a node and its reference position over all
 /// output times, max_k max_i |x_i(t_k) − x_ref,i(t_k)| (nodes of `dim`
 /// coordinates); 0 for empty trajectories.

@@ -586,6 +586,27 @@ impl Simulator {
         Ok(())
     }
 
+    /// Moves the generalized coordinates by `dy` (displacements of the free
+    /// DOFs in full space, modal coordinates in the modal space) and makes
+    /// the accelerations those of the new positions, as at the start of a
+    /// run: the start of a twin run a hair away from this one, which shows
+    /// how far a scene is predictable (`docs/method.md`, section 6). On
+    /// error nothing changes.
+    pub fn displace(&mut self, dy: &[f64]) -> Result<(), PhysicsError> {
+        if dy.len() != self.state.len() {
+            return Err(PhysicsError::SnapshotLength { len: dy.len(), expected: self.state.len() });
+        }
+        if !dy.iter().all(|x| x.is_finite()) {
+            return Err(PhysicsError::SnapshotNotFinite);
+        }
+        for (y, d) in self.state.y.iter_mut().zip(dy) {
+            *y += d;
+        }
+        self.engine.settle(&self.loads, &mut self.state);
+        self.refresh_outputs();
+        Ok(())
+    }
+
     /// The state and the loads: all a run needs to resume.
     pub fn snapshot(&self) -> Snapshot {
         Snapshot { state: self.state.clone(), loads: self.loads.clone() }

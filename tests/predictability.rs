@@ -1,0 +1,87 @@
+//! How far a scene is predictable (`docs/method.md`, section 6): full-space
+//! twins started 1e-7 m from the canonical start, each free node moved by a
+//! random vector of that length (seeded), against the canonical run. Cloth
+//! is chaotic: its twins' E reaches 1e-3 within the run and ends far above
+//! it; the paper's 2D sheet is regular: its twins stay within round-off of
+//! the perturbation. E measured on either over the whole run says as much
+//! about the scene as about any model.
+
+use modal_mass_spring::measures::{predictability, trajectory_errors_by_window, Masses};
+use modal_mass_spring::physics::*;
+use modal_mass_spring::scenes::{self, Setup};
+use rand_chacha::rand_core::{RngCore, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+const H: f64 = 0.01;
+
+/// Node positions after each of `steps` steps of `H`, the start moved by `kick`.
+fn run(setup: &Setup, steps: usize, kick: Option<&[f64]>) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let mut sim = setup.simulator().unwrap();
+    let start = sim.positions().to_vec();
+    if let Some(dy) = kick {
+        sim.displace(dy).unwrap();
+    }
+    let frames = (0..steps)
+        .map(|_| {
+            sim.do_step(H).unwrap();
+            sim.positions().to_vec()
+        })
+        .collect();
+    (start, frames)
+}
+
+/// Every free node moved by a random direction times `size` [m].
+fn nudge(dofs: usize, dim: usize, size: f64, seed: u64) -> Vec<f64> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut u = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+    let mut dy = vec![0.0; dofs];
+    for node in dy.chunks_exact_mut(dim) {
+        let v: Vec<f64> = (0..dim).map(|_| u()).collect();
+        let n = v.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-300);
+        for (d, x) in node.iter_mut().zip(&v) {
+            *d = size * x / n;
+        }
+    }
+    dy
+}
+
+/// (horizon, twins' floor at the end) of `setup` in full space over `steps` steps, 3 twins.
+fn horizon(setup: Setup, steps: usize) -> (Option<f64>, f64) {
+    let setup = setup.with_settings(Settings::new(Reduction::Full, Integrator::NewmarkExplicit, 0));
+    let (start, reference) = run(&setup, steps, None);
+    let scene = setup.grid.build().unwrap();
+    let twins: Vec<Vec<f64>> = (1..=3)
+        .map(|seed| {
+            let (_, frames) = run(&setup, steps, Some(&nudge(scene.n_dofs(), scene.dim, 1e-7, seed)));
+            trajectory_errors_by_window(&frames, &reference, &start, Masses::Equal)
+        })
+        .collect();
+    let times: Vec<f64> = (1..=steps).map(|k| k as f64 * H).collect();
+    predictability(&times, &twins, 1e-3)
+}
+
+#[test]
+fn cloth_is_predictable_for_a_while_the_paper_sheet_throughout() {
+    let (cloth, cloth_floor) = horizon(scenes::cloth(12, 12), 200);
+    let (paper, paper_floor) = horizon(scenes::canonical("paper-2d-top-row").unwrap(), 200);
+    println!(
+        "cloth 12 x 12: horizon {cloth:?} s, twins' E over 2 s {cloth_floor:.2e}; paper-2d-top-row: horizon {paper:?}, twins' E over 2 s {paper_floor:.2e}"
+    );
+    let t = cloth.expect("the cloth's twins part within 2 s");
+    assert!(t > 0.05 && t < 2.0, "{t}");
+    assert!(cloth_floor > 1e-2, "{cloth_floor}");
+    assert!(paper.is_none() && paper_floor < 1e-4, "{paper:?} {paper_floor}");
+}
+
+#[test]
+fn a_twin_start_of_the_wrong_size_or_not_finite_is_refused_with_the_state_kept() {
+    let mut sim =
+        scenes::canonical("paper-2d-top-row").unwrap().with_settings(Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 4)).simulator().unwrap();
+    sim.do_step(H).unwrap();
+    let before = sim.snapshot();
+    assert_eq!(sim.displace(&[0.0; 3]), Err(PhysicsError::SnapshotLength { len: 3, expected: 4 }));
+    assert_eq!(sim.displace(&[0.0, f64::NAN, 0.0, 0.0]), Err(PhysicsError::SnapshotNotFinite));
+    assert_eq!(sim.snapshot(), before);
+    sim.displace(&[1e-3, 0.0, 0.0, 0.0]).unwrap();
+    assert_eq!(sim.snapshot().state.y[0], before.state.y[0] + 1e-3);
+}
