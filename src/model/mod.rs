@@ -22,7 +22,7 @@ use std::path::Path;
 use crate::fmi::logging::Logger;
 use crate::fmi::model::{Computed, Model, StepEnd};
 use crate::fmi::serialize::Reader;
-use crate::fmi::variables::vr;
+use crate::fmi::variables::{index_of, vr, Causality, VARIABLES};
 use crate::fmi::{OK, WARNING};
 use crate::physics::{Loads, Simulator, Snapshot};
 
@@ -137,8 +137,12 @@ impl Model for MassSpring {
             p.fill_loads(&mut self.loads);
             let sim = self.sim.as_mut().expect("Step Mode has a simulator");
             sim.set_loads(&self.loads).map_err(|e| messages::describe(&e, p))?;
-            // New loads (gravity turned sideways, a point load) are checked after the next step.
-            self.residual_due = true;
+            // New parameters (gravity turned sideways, weights, damping) are checked after the
+            // next step; the inputs a master sets every step (the point load, the holder) are not,
+            // or the check would run after every step of a coupled run.
+            if vrs.iter().any(|&r| index_of(r).is_some_and(|i| VARIABLES[i].causality != Causality::Input)) {
+                self.residual_due = true;
+            }
         } else {
             self.stale = true;
         }
