@@ -59,16 +59,8 @@ impl Params {
     }
 
     pub fn loads(&self) -> Loads {
-        let mut loads = Loads {
-            gravity: [0.0; 3],
-            point_load: [0.0; 3],
-            load_node: None,
-            anchor: [0.0; 3],
-            rotation: [0.0; 3],
-            damping_alpha: 0.0,
-            damping_beta: 0.0,
-            mode_weights: Vec::new(),
-        };
+        // fill_loads writes every field.
+        let mut loads = Loads::physical(0);
         self.fill_loads(&mut loads);
         loads
     }

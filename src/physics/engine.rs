@@ -130,9 +130,9 @@ pub trait Probe {
     /// integrates at `state` (whose forces were evaluated last; see
     /// [`Scheme::acceleration`]) [N].
     fn momentum_rate(&mut self, state: &State) -> [f64; 3];
-    /// The mass moments at `state`: of the rates, and of y'' as above
-    /// (see [`Readout::moments`]).
-    fn moments(&mut self, state: &State) -> (Moments, Moments);
+    /// The mass moments of y'' at `state`, y'' as above (see
+    /// [`Readout::moments`]; those of the rates are [`Probe::motion`]).
+    fn acceleration_moments(&mut self, state: &State) -> Moments;
     /// Elastic energy of every spring at `state` (whose forces were evaluated last) [J].
     fn elastic_energy(&mut self, loads: &Loads, state: &State) -> f64;
     /// Elastic energy of every spring plus gravity potential at `state` [J].
@@ -359,9 +359,9 @@ impl<S: Readout, I: Scheme> Probe for Engine<S, I> {
         self.space.momentum(&self.acceleration)
     }
 
-    fn moments(&mut self, state: &State) -> (Moments, Moments) {
+    fn acceleration_moments(&mut self, state: &State) -> Moments {
         self.accelerate(state);
-        (self.space.moments(&state.y, &state.v), self.space.moments(&state.y, &self.acceleration))
+        self.space.moments(&state.y, &self.acceleration)
     }
 
     fn elastic_energy(&mut self, loads: &Loads, state: &State) -> f64 {

@@ -450,7 +450,7 @@ impl Simulator {
     /// 2 (w tr N - N w) - w x (J w); only z in 2D. O(r^2) in the modal space [N m].
     pub fn anchor_torque(&mut self) -> [f64; 3] {
         if !self.fresh.torque {
-            let (motion, driven) = self.engine.moments(&self.state);
+            let driven = self.engine.acceleration_moments(&self.state);
             let turned = self.turned();
             let loads = if turned { &self.local } else { &self.loads };
             let d = self.scene().dim;
@@ -465,7 +465,7 @@ impl Simulator {
             let inertial = driven.angular();
             t = std::array::from_fn(|i| t[i] - inertial[i]);
             if turned {
-                let w = self.state.spin;
+                let (w, motion) = (self.state.spin, self.engine.motion(&self.state));
                 let n = &motion.flux;
                 let (nw, jw) = (apply(n, &w), apply(&motion.second, &w));
                 let gyro = cross(&w, &jw);
