@@ -180,7 +180,7 @@ impl Space for Linear {
     }
     fn layout(&self) -> Layout<'_> {
         let n = self.lambda.len();
-        Layout { scene: &self.scene, coordinates: n, kept_modes: Some(n), springs: 0, frequencies: &self.frequencies, newton_scale: 1.0 }
+        Layout { scene: &self.scene, coordinates: n, kept_modes: Some(n), springs: 0, frequencies: &self.frequencies, trained: None, newton_scale: 1.0 }
     }
     fn work(&self) -> LinearWork {
         LinearWork { damping: vec![0.0; self.lambda.len()], load: vec![0.0; self.lambda.len()] }

@@ -27,6 +27,9 @@ pub fn variable(q: Quantity) -> &'static str {
         Quantity::ModeWeights => "modeWeights",
         Quantity::StepSize => "communicationStepSize",
         Quantity::CubatureTolerance => "cubatureTolerance",
+        Quantity::TrainingScale => "trainingScale",
+        Quantity::TrainingTilt => "trainingTilt",
+        Quantity::TrainingTime => "trainingTime",
     }
 }
 
@@ -72,7 +75,7 @@ pub fn describe(e: &PhysicsError, p: &Params) -> String {
         UnstableEquilibrium => "linearization = equilibrium: every equilibrium found under the loads is unstable (its stiffness has a \
                                 negative eigenvalue); use linearization = rest"
             .into(),
-        NoLoad => "modeSelection = load and staticCorrection = true build the basis from the loads at set-up, and gravity and the point load (loadX, loadY, loadZ) are zero: \
+        NoLoad => "modeSelection = load or trained and staticCorrection = true build the basis from the loads at set-up, and gravity and the point load (loadX, loadY, loadZ) are zero: \
                    set gravity or the point load before initialization, or use modeSelection = lowest without staticCorrection"
             .into(),
         LoadNode { .. } => format!(
@@ -112,6 +115,10 @@ pub fn describe(e: &PhysicsError, p: &Params) -> String {
         CubatureTrainingDiverged { time } => format!(
             "forceEvaluation = cubature: the exact reduced run under gravity that makes the training poses diverged at t = {time} s; \
              use forceEvaluation = exact"
+        ),
+        TrainingDiverged { case, time } => format!(
+            "modeSelection = trained: the full-space training run ({case}) diverged at t = {time} s; narrow the training range \
+             (trainingScale, trainingTilt) or choose another modeSelection"
         ),
         SetupDataMismatch { .. } => e.to_string(),
         SchemeNeedsDiagonal { scheme } => format!(

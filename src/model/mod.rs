@@ -43,6 +43,8 @@ pub struct MassSpring {
     residual_due: bool,
     residual_wait: u64,
     residual_gap: u64,
+    /// trainingRange passed trainingRangeLimit once, and the host was told.
+    range_warned: bool,
     /// The host set loadColumn; until then it follows the middle of the row (nx / 2).
     load_column_chosen: bool,
     /// Scratch for the loads handed to the simulator, filled in place and
@@ -64,6 +66,7 @@ impl Model for MassSpring {
             residual_due: true,
             residual_wait: 0,
             residual_gap: 1,
+            range_warned: false,
             load_column_chosen: false,
             loads: Params::start().loads(),
             springs: None,
@@ -75,6 +78,7 @@ impl Model for MassSpring {
         self.stale = true;
         self.residual_warned = false;
         self.residual_due = true;
+        self.range_warned = false;
         self.load_column_chosen = false;
         self.springs = None;
     }
@@ -163,6 +167,7 @@ impl Model for MassSpring {
             vr::POTENTIAL_ENERGY => Computed::Scalar(sim.potential_energy()),
             vr::MODE_FREQUENCIES => Computed::Array(sim.mode_frequencies()),
             vr::FORCE_RESIDUAL => Computed::Scalar(sim.force_residual()),
+            vr::TRAINING_RANGE => Computed::Scalar(sim.training_range()),
             vr::CUBATURE_SPRINGS => Computed::Scalar(sim.cubature_springs() as f64),
             vr::LOAD_NODE_X | vr::LOAD_NODE_Y | vr::LOAD_NODE_Z => Computed::Scalar(component(sim.load_node_position(), (r - vr::LOAD_NODE_X) as usize)),
             vr::LOAD_NODE_V_X | vr::LOAD_NODE_V_Y | vr::LOAD_NODE_V_Z => {
@@ -178,6 +183,21 @@ impl Model for MassSpring {
         let sim = self.sim.as_mut().expect("Step Mode has a simulator");
         if let Err(e) = sim.do_step(h) {
             return Err(messages::describe(&e, p));
+        }
+        // The trained range costs r operations; a limit of 0 turns it off.
+        let range_limit = p.scalar(vr::TRAINING_RANGE_LIMIT);
+        if !self.range_warned && range_limit > 0.0 {
+            let distance = sim.training_range();
+            if distance > range_limit {
+                self.range_warned = true;
+                let end = time0 + sim.time();
+                return Ok(StepEnd::Warning(format!(
+                    "at t = {end} trainingRange = {distance:.3} passed trainingRangeLimit = {range_limit}: the run has left the \
+                     positions the trained basis was trained on (gravity, point load or holder motion outside the training \
+                     program); the results may leave the full-space model (widen trainingScale or trainingTilt, or bake the \
+                     basis for these loads)"
+                )));
+            }
         }
         // A check costs one pass over every spring; a limit of 0 turns it off.
         let limit = p.scalar(vr::FORCE_RESIDUAL_LIMIT);

@@ -5,7 +5,7 @@
 use crate::fmi::params::Params;
 use crate::fmi::variables::{index_of, vr, SCENES};
 use crate::options::{FixedNodes, ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction};
-use crate::physics::{Grid, Loads, PhysicsError, Settings, SetupData, Simulator};
+use crate::physics::{Grid, Loads, PhysicsError, Settings, SetupData, Simulator, Training};
 
 impl Params {
     /// The start values of the canonical scene `name` (the `[scenes.NAME]`
@@ -55,6 +55,7 @@ impl Params {
             cubature_tolerance: self.scalar(vr::CUBATURE_TOLERANCE),
             max_internal_step: self.scalar(vr::MAX_INTERNAL_STEP),
             substepping: true,
+            training: Training { scale: self.scalar(vr::TRAINING_SCALE), tilt: self.scalar(vr::TRAINING_TILT), time: self.scalar(vr::TRAINING_TIME) },
         }
     }
 

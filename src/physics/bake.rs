@@ -1,7 +1,7 @@
 //! What a modal set-up computes that costs time, as data: the basis and
-//! its linearization point, the explicit-step bound, the cubature set. A
-//! simulator built from it ([`super::Simulator::with_setup`]) skips the
-//! eigen decomposition, the equilibrium and the cubature training and runs
+//! its linearization point, the explicit-step bound, the cubature set, the
+//! range of a trained basis. A simulator built from it ([`super::Simulator::with_setup`]) skips the
+//! eigen decomposition, the equilibrium, the training runs and the cubature training and runs
 //! bit for bit as one that computed them, since every later quantity is
 //! derived from these values by the same code.
 //!
@@ -21,6 +21,40 @@ pub struct SpringSet {
     pub held_out_error: f64,
 }
 
+/// The range a trained basis was trained for (`docs/method.md`, section 3):
+/// per basis vector j the centre c_j and half-width h_j of the box its
+/// coordinate spanned over the training snapshots.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TrainedRange {
+    pub center: Vec<f64>,
+    pub half_width: Vec<f64>,
+}
+
+impl TrainedRange {
+    /// The box of the coordinates `snapshots` (each one value per basis
+    /// vector). A half-width is at least 1e-3 of the largest, so a vector
+    /// the snapshots hardly move does not make round-off read as leaving.
+    pub fn of(snapshots: &[Vec<f64>], r: usize) -> Self {
+        let (mut lo, mut hi) = (vec![f64::INFINITY; r], vec![f64::NEG_INFINITY; r]);
+        for q in snapshots {
+            for j in 0..r {
+                lo[j] = lo[j].min(q[j]);
+                hi[j] = hi[j].max(q[j]);
+            }
+        }
+        let center: Vec<f64> = (0..r).map(|j| 0.5 * (lo[j] + hi[j])).collect();
+        let mut half_width: Vec<f64> = (0..r).map(|j| 0.5 * (hi[j] - lo[j])).collect();
+        let floor = 1e-3 * half_width.iter().fold(0.0f64, |m, h| m.max(*h));
+        half_width.iter_mut().for_each(|h| *h = h.max(floor).max(f64::MIN_POSITIVE));
+        TrainedRange { center, half_width }
+    }
+
+    /// max_j |q_j - c_j| / h_j: at most 1 inside the box.
+    pub fn distance(&self, q: &[f64]) -> f64 {
+        q.iter().zip(&self.center).zip(&self.half_width).fold(0.0, |m, ((q, c), h)| m.max((q - c).abs() / h))
+    }
+}
+
 /// The products of a modal set-up.
 #[derive(Clone, Debug)]
 pub struct SetupData {
@@ -31,10 +65,12 @@ pub struct SetupData {
     /// Squared-frequency bound of the reduced system with every spring [1/s^2].
     pub omega_sq_bound: f64,
     pub cubature: Option<SpringSet>,
+    /// The range of a trained basis.
+    pub range: Option<TrainedRange>,
 }
 
 const MAGIC: &[u8; 8] = b"MMSSETUP";
-const FORMAT: u32 = 1;
+const FORMAT: u32 = 2;
 
 impl SetupData {
     pub fn to_bytes(&self) -> Vec<u8> {
@@ -59,6 +95,14 @@ impl SetupData {
                 words(&mut b, &c.springs.iter().map(|&s| s as f64).collect::<Vec<_>>());
                 words(&mut b, &c.weights);
                 words(&mut b, &[c.training_error, c.held_out_error]);
+            }
+        }
+        match &self.range {
+            None => b.push(0),
+            Some(t) => {
+                b.push(1);
+                words(&mut b, &t.center);
+                words(&mut b, &t.half_width);
             }
         }
         b
@@ -98,10 +142,25 @@ impl SetupData {
             }
             _ => return None,
         };
+        let range = match r.take(1)?[0] {
+            0 => None,
+            1 => {
+                let (center, half_width) = (r.words()?, r.words()?);
+                if center.len() != rr
+                    || half_width.len() != rr
+                    || !center.iter().all(|c| c.is_finite())
+                    || !half_width.iter().all(|h| h.is_finite() && *h > 0.0)
+                {
+                    return None;
+                }
+                Some(TrainedRange { center, half_width })
+            }
+            _ => return None,
+        };
         if r.at != bytes.len() || lambda.len() != rr || phi.len() != n.checked_mul(rr)? {
             return None;
         }
-        Some(SetupData { basis: ModalBasis { n, r: rr, lambda, phi }, point, at_rest, omega_sq_bound, cubature })
+        Some(SetupData { basis: ModalBasis { n, r: rr, lambda, phi }, point, at_rest, omega_sq_bound, cubature, range })
     }
 }
 

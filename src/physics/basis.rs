@@ -113,14 +113,10 @@ pub fn external_load(scene: &Scene, loads: &Loads) -> Vec<f64> {
     f
 }
 
-/// The basis of `n_modes` vectors on `scene` under `loads`, chosen and
-/// linearized as `settings` ask (`mode_selection`, `static_correction`,
-/// `linearization`, `anchor_motion`).
-pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) -> Result<Basis, PhysicsError> {
-    let n = scene.n_dofs();
-    if n_modes > n {
-        return Err(PhysicsError::ModesExceedDofs { modes: n_modes, dofs: n });
-    }
+/// The linearization point x* `settings` ask for (rest, or the static
+/// equilibrium under the set-up loads), the stiffness pattern and the
+/// upper triangle of K(x*).
+pub fn linearize(scene: &Scene, loads: &Loads, settings: &Settings) -> Result<(Vec<f64>, StiffnessPattern, Vec<f64>), PhysicsError> {
     let pattern = StiffnessPattern::new(scene);
     let point = match settings.linearization {
         Linearization::Rest => scene.rest.clone(),
@@ -128,13 +124,61 @@ pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) 
     };
     let mut stiffness = vec![0.0; pattern.nnz()];
     pattern.add_tangent(scene, &point, 1.0, &mut stiffness);
+    Ok((point, pattern, stiffness))
+}
+
+/// The vectors a static correction adds to a basis linearized at `point`:
+/// at rest the static responses K⁻¹ f to every load pattern; at the
+/// equilibrium the sag x* - x_rest itself (known exactly), and with the
+/// holder moving or turning the responses to its inertial loads through
+/// the tangent stiffness there.
+pub fn static_vectors(
+    scene: &Scene,
+    pattern: &StiffnessPattern,
+    stiffness: &[f64],
+    point: &[f64],
+    patterns: &[Vec<f64>],
+    settings: &Settings,
+) -> Result<Vec<Vec<f64>>, PhysicsError> {
+    let n = scene.n_dofs();
+    if settings.linearization == Linearization::Rest {
+        let solver = ShiftedStiffness::new(scene, pattern, stiffness)?;
+        return Ok(patterns.iter().map(|f| solver.solve(f)).collect());
+    }
+    let mut vectors = vec![(0..n).map(|k| point[k] - scene.rest[k]).collect::<Vec<f64>>()];
+    if settings.anchor_motion || settings.anchor_rotation {
+        let solver = ShiftedStiffness::new(scene, pattern, stiffness)?;
+        let translation = if settings.anchor_motion { scene.dim } else { 0 };
+        let rotation = if settings.anchor_rotation { 2 * if scene.dim == 2 { 1 } else { 3 } } else { 0 };
+        let inertial = patterns[..translation].iter().chain(&patterns[patterns.len() - rotation..]);
+        vectors.extend(inertial.map(|f| solver.solve(f)));
+    }
+    Ok(vectors)
+}
+
+/// The basis of `n_modes` vectors on `scene` under `loads`, chosen and
+/// linearized as `settings` ask (`mode_selection`, `static_correction`,
+/// `linearization`, `anchor_motion`). A trained basis comes from its
+/// training program ([`super::snapshots`]), not from here: where one is
+/// asked for only to report modal coordinates (full space), the lowest
+/// modes are reported.
+pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) -> Result<Basis, PhysicsError> {
+    let n = scene.n_dofs();
+    if n_modes > n {
+        return Err(PhysicsError::ModesExceedDofs { modes: n_modes, dofs: n });
+    }
+    let (point, pattern, stiffness) = linearize(scene, loads, settings)?;
     let at_rest = settings.linearization == Linearization::Rest;
     let patterns = load_patterns(scene, loads, settings.anchor_motion, settings.anchor_rotation);
-    let needs_load = settings.mode_selection == ModeSelection::Load || settings.static_correction;
+    let selection = match settings.mode_selection {
+        ModeSelection::Trained => ModeSelection::Lowest,
+        other => other,
+    };
+    let needs_load = selection == ModeSelection::Load || settings.static_correction;
     if needs_load && patterns.is_empty() {
         return Err(PhysicsError::NoLoad);
     }
-    let plain = settings.mode_selection == ModeSelection::Lowest && !settings.static_correction;
+    let plain = selection == ModeSelection::Lowest && !settings.static_correction;
     let modes = if plain {
         ModalBasis::lowest(scene, &pattern, &stiffness, n_modes)?
     } else {
@@ -143,32 +187,18 @@ pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) 
         // Candidates in the order they are wanted; a few more than needed
         // stand in for static responses the modes already hold.
         let spare = if settings.static_correction { statics } else { 0 };
-        let candidates = match settings.mode_selection {
-            ModeSelection::Lowest => ModalBasis::lowest(scene, &pattern, &stiffness, (eigen + spare).min(n))?,
+        let candidates = match selection {
             ModeSelection::Load => {
                 // Away from rest the run starts displaced from x* by x_rest - x*: its modal amplitudes count too.
                 let start: Option<Vec<f64>> = (!at_rest).then(|| (0..n).map(|k| scene.rest[k] - point[k]).collect());
                 ranked(scene, &pattern, &stiffness, &patterns, start.as_deref(), (eigen + spare).min(n))?
             }
+            _ => ModalBasis::lowest(scene, &pattern, &stiffness, (eigen + spare).min(n))?,
         };
         let columns = |b: &ModalBasis, j: usize| -> Vec<f64> { (0..n).map(|i| b.phi[i * b.r + j]).collect() };
         let mut vectors: Vec<Vec<f64>> = (0..eigen.min(candidates.r)).map(|j| columns(&candidates, j)).collect();
         if settings.static_correction {
-            if at_rest {
-                let solver = ShiftedStiffness::new(scene, &pattern, &stiffness)?;
-                vectors.extend(patterns.iter().map(|f| solver.solve(f)));
-            } else {
-                // At the equilibrium the sag is known exactly: the displacement from rest.
-                vectors.push((0..n).map(|k| point[k] - scene.rest[k]).collect());
-                if settings.anchor_motion || settings.anchor_rotation {
-                    // The holder's inertial loads act around the equilibrium, through its tangent stiffness.
-                    let solver = ShiftedStiffness::new(scene, &pattern, &stiffness)?;
-                    let translation = if settings.anchor_motion { scene.dim } else { 0 };
-                    let rotation = if settings.anchor_rotation { 2 * if scene.dim == 2 { 1 } else { 3 } } else { 0 };
-                    let inertial = patterns[..translation].iter().chain(&patterns[patterns.len() - rotation..]);
-                    vectors.extend(inertial.map(|f| solver.solve(f)));
-                }
-            }
+            vectors.extend(static_vectors(scene, &pattern, &stiffness, &point, &patterns, settings)?);
             vectors.extend((eigen..candidates.r).map(|j| columns(&candidates, j)));
         }
         orthonormal_ritz(scene, &pattern, &stiffness, &vectors, n_modes)?
@@ -321,7 +351,7 @@ impl<'a> MOrthonormal<'a> {
 /// The first `r` independent directions of `vectors` (in their order),
 /// M-orthonormalized ([`MOrthonormal`]), then diagonalized in their span
 /// ([`rayleigh_ritz`]).
-fn orthonormal_ritz(scene: &Scene, pattern: &StiffnessPattern, stiffness: &[f64], vectors: &[Vec<f64>], r: usize) -> Result<ModalBasis, PhysicsError> {
+pub fn orthonormal_ritz(scene: &Scene, pattern: &StiffnessPattern, stiffness: &[f64], vectors: &[Vec<f64>], r: usize) -> Result<ModalBasis, PhysicsError> {
     let mut q = MOrthonormal::new(&scene.dof_mass, r);
     for v in vectors {
         if q.full() {

@@ -14,10 +14,10 @@ use super::error::{PhysicsError, StepFailure};
 use super::frame::{Frame, Moments};
 use super::integrator::{Buffers, NewmarkExplicit, NewmarkImplicit, Scheme, Trigonometric};
 use super::scene::Scene;
-use super::settings::{ForceEvaluation, Integrator, Reduction, Settings};
+use super::settings::{ForceEvaluation, Integrator, ModeSelection, Reduction, Settings};
 use super::space::{Cubature, Exact, Full, Layout, Modal, Readout};
 use super::state::{Loads, State};
-use super::training;
+use super::{snapshots, training};
 
 /// The registry: builds the space `settings.reduction` names on `scene`
 /// (with the force model `settings.force_evaluation` names in the modal
@@ -26,6 +26,15 @@ use super::training;
 /// set-up: the basis options that depend on the loads use them.
 /// `prebuilt` (modal space only) replaces the costly part of the set-up.
 pub(crate) fn build(scene: Scene, settings: &Settings, loads: &Loads, prebuilt: Option<&SetupData>) -> Result<Box<dyn Stepper>, PhysicsError> {
+    // A trained basis (and its cubature) comes from its training program unless it is stored.
+    let trained_basis;
+    let prebuilt = match prebuilt {
+        None if settings.reduction == Reduction::Modal && settings.mode_selection == ModeSelection::Trained => {
+            trained_basis = snapshots::train(scene.clone(), loads, settings)?;
+            Some(&trained_basis)
+        }
+        given => given,
+    };
     match settings.reduction {
         Reduction::Modal => match settings.force_evaluation {
             ForceEvaluation::Exact => bind(Modal::<Exact>::new(scene, loads, settings, prebuilt)?, settings.integrator),
@@ -35,7 +44,7 @@ pub(crate) fn build(scene: Scene, settings: &Settings, loads: &Loads, prebuilt: 
                 let prebuilt = match prebuilt {
                     Some(data) if data.cubature.is_some() => Some(data),
                     _ => {
-                        trained = training::train(scene.clone(), loads, settings, prebuilt)?;
+                        trained = training::train(scene.clone(), loads, settings, prebuilt, None)?;
                         Some(&trained)
                     }
                 };

@@ -46,6 +46,12 @@ pub enum Quantity {
     StepSize,
     /// Relative error the cubature set is grown to reach.
     CubatureTolerance,
+    /// Relative change of gravity's magnitude a trained basis trains for.
+    TrainingScale,
+    /// Tilt of gravity a trained basis trains for [rad].
+    TrainingTilt,
+    /// Length of each training run of a trained basis [s].
+    TrainingTime,
 }
 
 impl Quantity {
@@ -70,6 +76,9 @@ impl Quantity {
             Quantity::ModeWeights => "mode weights",
             Quantity::StepSize => "communication step",
             Quantity::CubatureTolerance => "cubature tolerance",
+            Quantity::TrainingScale => "training range of gravity's magnitude",
+            Quantity::TrainingTilt => "training range of gravity's tilt",
+            Quantity::TrainingTime => "length of a training run",
         }
     }
 }
@@ -92,6 +101,12 @@ pub enum Expected {
     /// At least this value.
     #[error("at least {0}")]
     AtLeast(f64),
+    /// At least 0 and below this value.
+    #[error("finite, at least 0 and below {0}")]
+    NonNegativeBelow(f64),
+    /// At least 0 and at most this value.
+    #[error("finite, at least 0 and at most {0}")]
+    NonNegativeAtMost(f64),
     /// Above 0 and at most this value.
     #[error("above 0 and at most {0}")]
     PositiveAtMost(f64),
@@ -236,6 +251,9 @@ pub enum PhysicsError {
     /// The exact reduced run that makes the cubature's training poses diverged.
     #[error("the exact reduced run that makes the cubature's training poses diverged at t = {time} s; use exact forces")]
     CubatureTrainingDiverged { time: f64 },
+    /// A full-space training run of a trained basis diverged.
+    #[error("the full-space training run of the trained basis ({case}) diverged at t = {time} s; narrow the training range (trainingScale, trainingTilt) or use another modeSelection")]
+    TrainingDiverged { case: String, time: f64 },
     /// Stored set-up data that does not fit the scene and solver.
     #[error("the stored set-up data does not fit the scene and solver: {what}")]
     SetupDataMismatch { what: &'static str },

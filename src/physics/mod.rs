@@ -14,6 +14,7 @@
 //! - [`frame`]: the holder's frame and the mass moments of the sheet in it;
 //! - [`state`]: [`State`] and [`Loads`], what changes while running;
 //! - [`simulator`]: set-up, sub-stepping, divergence checks, outputs;
+//! - [`snapshots`]: trained bases, a set-up stage that runs the full-space model under a training program;
 //! - [`training`]: the cubature's training, a set-up stage that runs the exact reduced model;
 //! - [`bake`]: the costly products of a modal set-up as data, to store and reuse;
 //! - [`error`]: typed errors that name the quantity and the limit.
@@ -34,15 +35,16 @@ pub mod modes;
 pub mod scene;
 pub mod settings;
 pub mod simulator;
+pub mod snapshots;
 pub mod space;
 pub mod state;
 pub mod training;
 
-pub use bake::{SetupData, SpringSet};
+pub use bake::{SetupData, SpringSet, TrainedRange};
 pub use error::{PhysicsError, Quantity, StepFailure};
 pub use grid::{FixedNodes, Grid};
 pub use integrator::EXPLICIT_SAFETY;
 pub use scene::Scene;
-pub use settings::{ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction, Settings};
+pub use settings::{ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction, Settings, Training};
 pub use simulator::{internal_step_count, Simulator, MAX_INTERNAL_STEPS_PER_CALL, STEP_COUNT_TOLERANCE};
 pub use state::{Loads, Snapshot, State};

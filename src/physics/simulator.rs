@@ -504,6 +504,12 @@ impl Simulator {
     pub fn setup_data(&self) -> Option<SetupData> {
         self.engine.setup_data()
     }
+    /// How far the state is from the range a trained basis was trained
+    /// for ([`super::TrainedRange::distance`] of the modal coordinates: at
+    /// most 1 inside); 0 for other bases and in full space. O(r).
+    pub fn training_range(&self) -> f64 {
+        self.engine.layout().trained.map_or(0.0, |t| t.distance(&self.state.y))
+    }
     /// Springs one force evaluation visits: every spring, or the cubature set.
     pub fn cubature_springs(&self) -> usize {
         self.engine.layout().springs

@@ -58,8 +58,18 @@ type Poses = Vec<Vec<f64>>;
 
 /// The costly part of a cubature set-up: the basis `settings` ask for (or
 /// that of `prebuilt`), and the spring set trained on it, as data for
-/// `Modal::<Cubature>::new`.
-pub fn train(scene: Scene, loads: &Loads, settings: &Settings, prebuilt: Option<&SetupData>) -> Result<SetupData, PhysicsError> {
+/// `Modal::<Cubature>::new`. The training poses come from `snapshots`
+/// (modal coordinates, e.g. a trained basis's training program) when
+/// given, at most 2 [`RUN_POSES`] of them taken evenly, alternately
+/// training and held out; else from a short exact reduced run and random
+/// poses around it.
+pub fn train(
+    scene: Scene,
+    loads: &Loads,
+    settings: &Settings,
+    prebuilt: Option<&SetupData>,
+    snapshots: Option<&[Vec<f64>]>,
+) -> Result<SetupData, PhysicsError> {
     let tol = settings.cubature_tolerance;
     if !(tol > 0.0 && tol <= 1.0) {
         return Err(PhysicsError::Invalid { quantity: Quantity::CubatureTolerance, value: tol, expected: Expected::PositiveAtMost(1.0) });
@@ -68,7 +78,18 @@ pub fn train(scene: Scene, loads: &Loads, settings: &Settings, prebuilt: Option<
         return Err(PhysicsError::CubatureTooManyModes { modes: settings.n_modes, limit: MAX_MODES });
     }
     let space = Modal::<Exact>::new(scene, loads, settings, prebuilt)?;
-    let (train_poses, held_poses) = poses(&space, loads, settings)?;
+    let (train_poses, held_poses) = match snapshots {
+        Some(all) => {
+            // The snapshots span the motions already: every other one trains, the rest are held out.
+            let m = all.len().min(2 * RUN_POSES);
+            let taken: Vec<&Vec<f64>> = (0..m).map(|i| &all[i * all.len() / m]).collect();
+            (taken.iter().step_by(2).map(|q| q.to_vec()).collect(), taken.iter().skip(1).step_by(2).map(|q| q.to_vec()).collect())
+        }
+        None => {
+            let (run, start) = run_poses(&space, loads, settings)?;
+            around(&space, &run, &start)
+        }
+    };
     let set = match space.scene().dim {
         2 => select::<2>(&space, tol, &train_poses, &held_poses)?,
         _ => select::<3>(&space, tol, &train_poses, &held_poses)?,
@@ -220,17 +241,14 @@ fn fit<const D: usize>(chosen: &[Chosen<D>], target: &[f64]) -> Result<Vec<f64>,
     Ok(x.iter().zip(&norms).map(|(x, n)| x / n).collect())
 }
 
-/// Training and held-out poses: every other sample of a short exact run of
+/// The poses of a short exact run of
 /// the reduced model `space` under the set-up gravity and point load, and
 /// with anchor motion ahead ([`Settings::anchor_motion`]) the inertial load
 /// of an anchor accelerating at |g| (at least 1 m/s^2) along +x, +y and +z
 /// at once (from the rest state, unit weights, no damping, explicit Newmark
-/// at its stable step, one period of the slowest kept mode up to 2 s), and
-/// around them random poses q_start + s (q_t - q_start) + delta, s uniform
-/// in [0.5, 1.25], delta_j uniform within a quarter of mode j's amplitude in
-/// the run. With no motion (no load), the amplitude is 1 % of a whole-sheet
-/// displacement by the scene's length scale.
-fn poses(space: &Modal<Exact>, set_up: &Loads, settings: &Settings) -> Result<(Poses, Poses), PhysicsError> {
+/// at its stable step, one period of the slowest kept mode up to 2 s), with
+/// the coordinates of the rest state it starts from.
+fn run_poses(space: &Modal<Exact>, set_up: &Loads, settings: &Settings) -> Result<(Poses, Vec<f64>), PhysicsError> {
     let (scene, modes) = (space.scene(), space.modes());
     let r = modes.basis.r;
     let mut loads = Loads { damping_alpha: 0.0, damping_beta: 0.0, anchor: [0.0; 3], mode_weights: vec![1.0; r], ..set_up.clone() };
@@ -264,6 +282,16 @@ fn poses(space: &Modal<Exact>, set_up: &Loads, settings: &Settings) -> Result<(P
             run.push(state.y.clone());
         }
     }
+    Ok((run, start))
+}
+
+/// Training and held-out poses: every other pose of `run` (which starts
+/// from `start`), and around them random poses q_start + s (q_t - q_start) + delta, s uniform
+/// in [0.5, 1.25], delta_j uniform within a quarter of mode j's amplitude in
+/// the run. With no motion (no load), the amplitude is 1 % of a whole-sheet
+/// displacement by the scene's length scale.
+fn around(space: &Modal<Exact>, run: &[Vec<f64>], start: &[f64]) -> (Poses, Poses) {
+    let (scene, r) = (space.scene(), space.modes().basis.r);
     let mut amplitude: Vec<f64> = (0..r).map(|j| run.iter().fold(0.0f64, |m, p| m.max((p[j] - start[j]).abs()))).collect();
     if amplitude.iter().all(|a| *a == 0.0) {
         let whole = scene.free_mass().sqrt() * scene.length_scale();
@@ -283,7 +311,7 @@ fn poses(space: &Modal<Exact>, set_up: &Loads, settings: &Settings) -> Result<(P
     train.extend(random(2));
     let mut held: Vec<Vec<f64>> = run.iter().skip(1).step_by(2).cloned().collect();
     held.extend(random(3));
-    Ok((train, held))
+    (train, held)
 }
 
 #[cfg(test)]
@@ -313,7 +341,7 @@ mod tests {
             cubature_tolerance: 0.002,
             ..Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 6)
         };
-        let data = train(scene.clone(), &loads, &settings, None).unwrap();
+        let data = train(scene.clone(), &loads, &settings, None, None).unwrap();
         let modes = Modes::new(data.basis.clone(), data.point.clone(), data.at_rest);
         let setup = ForceSetup { loads: &loads, settings: &settings, omega_sq_bound: data.omega_sq_bound, prebuilt: data.cubature.as_ref() };
         let cub = Cubature::new(&scene, &modes, &setup).unwrap();

@@ -2,7 +2,7 @@
 //! outputs, each method with the equation it computes; and [`Diagonal`],
 //! the linear part of the equations where it is diagonal.
 
-use crate::physics::bake::SetupData;
+use crate::physics::bake::{SetupData, TrainedRange};
 use crate::physics::error::StepFailure;
 use crate::physics::frame::{Frame, Moments};
 use crate::physics::scene::Scene;
@@ -38,6 +38,8 @@ pub struct Layout<'a> {
     pub frequencies: &'a [f64],
     /// Scale of y below which Newton updates count as converged.
     pub newton_scale: f64,
+    /// The range a trained basis was trained for (modal space with a trained basis).
+    pub trained: Option<&'a TrainedRange>,
 }
 
 /// The equations of one space, as the schemes step them; see the module

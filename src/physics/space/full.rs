@@ -273,6 +273,7 @@ impl Space for Full {
             springs: self.scene.springs.len(),
             frequencies: &self.frequencies,
             newton_scale: self.newton_scale,
+            trained: None,
         }
     }
 

@@ -28,4 +28,4 @@ mod modal;
 
 pub use equations::{Diagonal, Layout, Readout, Space};
 pub use full::Full;
-pub use modal::{Candidate, Cubature, Exact, ForceSetup, Modal, Modes, ReducedForce};
+pub use modal::{basis_bound, Candidate, Cubature, Exact, ForceSetup, Modal, Modes, ReducedForce};

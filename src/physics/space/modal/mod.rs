@@ -31,7 +31,7 @@ pub use inertia::Inertia;
 pub use reduced::{taut_reduced_bound, ForceSetup, Modes, ReducedForce};
 
 use super::equations::{Diagonal, Layout, Readout, Space};
-use crate::physics::bake::SetupData;
+use crate::physics::bake::{SetupData, TrainedRange};
 use crate::physics::basis;
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::forces::omega_sq_bound_full;
@@ -63,6 +63,8 @@ pub struct Modal<F: ReducedForce = Exact> {
     inertia: Inertia,
     /// sum m_k (x*_k - x_rest,k) per axis, for the potential of turned gravity.
     sag: [f64; 3],
+    /// The range a trained basis was trained for.
+    range: Option<TrainedRange>,
 }
 
 /// Load terms and scratch of a modal run.
@@ -118,9 +120,8 @@ impl<F: ReducedForce> Modal<F> {
             }
             None => {
                 let built = basis::build(&scene, loads, n_modes, settings)?;
-                let basis = built.modes;
-                let bound = if basis.r <= DENSE_BOUND_MODES { taut_reduced_bound(&scene, &basis)? } else { omega_sq_bound_full(&scene) };
-                (Modes::new(basis, built.point, built.at_rest), bound)
+                let bound = basis_bound(&scene, &built.modes)?;
+                (Modes::new(built.modes, built.point, built.at_rest), bound)
             }
         };
         let newton_scale = scene.free_mass().sqrt() * scene.length_scale().max(f64::MIN_POSITIVE);
@@ -135,7 +136,8 @@ impl<F: ReducedForce> Modal<F> {
         for k in 0..modes.basis.n {
             sag[k % d] += scene.dof_mass[k] * (modes.point[k] - scene.rest[k]);
         }
-        Ok(Modal { force, frequencies, omega_sq_bound, bound, newton_scale, inv_mass, inertia, sag, modes, scene })
+        let range = prebuilt.and_then(|d| d.range.clone());
+        Ok(Modal { force, frequencies, omega_sq_bound, bound, newton_scale, inv_mass, inertia, sag, range, modes, scene })
     }
 
     /// The kept modes.
@@ -164,6 +166,7 @@ impl<F: ReducedForce> Space for Modal<F> {
             springs: self.force.springs(&self.scene),
             frequencies: &self.frequencies,
             newton_scale: self.newton_scale,
+            trained: self.range.as_ref(),
         }
     }
 
@@ -174,6 +177,7 @@ impl<F: ReducedForce> Space for Modal<F> {
             at_rest: self.modes.at_rest,
             omega_sq_bound: self.bound,
             cubature: self.force.spring_set(),
+            range: self.range.clone(),
         })
     }
 
@@ -531,6 +535,17 @@ impl<F: ReducedForce> Readout for Modal<F> {
 }
 /// Stored set-up data fits `scene` and `n_modes`: sizes, finite values, unit-mass modes are not re-checked
 /// (the data is what a set-up of the same parameters wrote).
+/// Squared-frequency bound of the reduced system on `basis` with every
+/// spring: the eigenvalues of the reduced taut stiffness up to
+/// [`DENSE_BOUND_MODES`] modes, the full-space bound above.
+pub fn basis_bound(scene: &Scene, basis: &ModalBasis) -> Result<f64, PhysicsError> {
+    if basis.r <= DENSE_BOUND_MODES {
+        taut_reduced_bound(scene, basis)
+    } else {
+        Ok(omega_sq_bound_full(scene))
+    }
+}
+
 fn check_prebuilt(scene: &Scene, n_modes: usize, data: &SetupData) -> Result<(), PhysicsError> {
     let b = &data.basis;
     let fail = |what| Err(PhysicsError::SetupDataMismatch { what });
@@ -542,6 +557,9 @@ fn check_prebuilt(scene: &Scene, n_modes: usize, data: &SetupData) -> Result<(),
     }
     if !b.phi.iter().chain(&b.lambda).chain(&data.point).all(|x| x.is_finite()) || !(data.omega_sq_bound >= 0.0 && data.omega_sq_bound.is_finite()) {
         return fail("non-finite values");
+    }
+    if data.range.as_ref().is_some_and(|t| t.center.len() != b.r || t.half_width.len() != b.r) {
+        return fail("trained range size");
     }
     if let Some(c) = &data.cubature {
         if c.springs.len() != c.weights.len() || c.springs.iter().any(|&s| s >= scene.springs.len()) || !c.weights.iter().all(|w| w.is_finite() && *w > 0.0) {
