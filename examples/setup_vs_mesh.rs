@@ -1,13 +1,15 @@
 //! Set-up time of the modal space against the mesh size: the cloth-3d
 //! scene on n x n nodes, 30 modes (by default), the lowest modes and the
-//! modes ranked by their static response to gravity (`docs/method.md`,
-//! section 3), each without and with the static correction. One line per
+//! modes ranked by their static response to gravity and the trained basis
+//! (`docs/method.md`, section 3), each without and with the static correction. One line per
 //! case.
 //!
-//! cargo run --release --example setup_vs_mesh -- [n...] [--modes r] [--lowest | --load] [--no-correction | --only-correction]
+//! cargo run --release --example setup_vs_mesh -- [n...] [--modes r] [--lowest | --load | --trained] [--no-correction | --only-correction]
 //!
 //! Columns: `basis_s` is `basis::build` on its own (assembly of K, the
-//! factorization of K − σM, the eigen or Ritz solution, Rayleigh–Ritz);
+//! factorization of K − σM, the eigen or Ritz solution, Rayleigh–Ritz),
+//! for a trained basis `snapshots::train` (the training runs, the SVD,
+//! Rayleigh–Ritz);
 //! `setup_s` the whole simulator set-up on the same scene, which builds the
 //! basis again; `other_s` = setup_s − basis_s, the rest of the set-up (the
 //! force model, the step-size bound, the first outputs). `omega_1` is the
@@ -15,7 +17,7 @@
 
 use std::time::Instant;
 
-use modal_mass_spring::physics::basis;
+use modal_mass_spring::physics::{basis, snapshots};
 use modal_mass_spring::physics::{Integrator, ModeSelection, Reduction, Settings, Simulator};
 use modal_mass_spring::scenes;
 
@@ -37,6 +39,7 @@ fn parse_args() -> Result<Args, lexopt::Error> {
             Long("only-correction") => args.corrections = vec![true],
             Long("lowest") => args.selections = vec![ModeSelection::Lowest],
             Long("load") => args.selections = vec![ModeSelection::Load],
+            Long("trained") => args.selections = vec![ModeSelection::Trained],
             Value(v) => args.sizes.push(v.parse()?),
             _ => return Err(arg.unexpected()),
         }
@@ -58,7 +61,7 @@ fn solver(modes: usize, selection: ModeSelection, static_correction: bool) -> Se
 fn main() {
     let Args { sizes, modes, corrections, selections } = parse_args().unwrap_or_else(|e| {
         eprintln!("setup_vs_mesh: {e} (sizes are numbers of nodes per side)");
-        eprintln!("usage: setup_vs_mesh [n...] [--modes r] [--lowest | --load] [--no-correction | --only-correction]");
+        eprintln!("usage: setup_vs_mesh [n...] [--modes r] [--lowest | --load | --trained] [--no-correction | --only-correction]");
         std::process::exit(2)
     });
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
@@ -73,10 +76,14 @@ fn main() {
                 let scene = setup.grid.build().expect("cloth scene");
                 let dofs = scene.n_dofs();
                 let t0 = Instant::now();
-                let built = basis::build(&scene, &setup.loads, modes, &setup.settings);
+                // A trained basis is built by its training program (full-space runs, then the SVD).
+                let built = match selection {
+                    ModeSelection::Trained => snapshots::train(scene.clone(), &setup.loads, &setup.settings).map(|d| d.basis),
+                    _ => basis::build(&scene, &setup.loads, modes, &setup.settings).map(|b| b.modes),
+                };
                 let basis_s = t0.elapsed().as_secs_f64();
                 let omega_1 = match built {
-                    Ok(b) => b.modes.frequencies()[0],
+                    Ok(b) => b.frequencies()[0],
                     Err(e) => {
                         println!("{n:>5} {dofs:>8} {select:>7} {correction:>10} basis failed: {e}");
                         continue;

@@ -234,7 +234,7 @@ fn every_output_declares_its_dependencies_on_the_point_load() {
         assert!(xml.contains(&want), "{}: {want} not in the model description", v.name);
         outputs += 1;
     }
-    assert_eq!(outputs, 18);
+    assert_eq!(outputs, 19);
 }
 
 #[test]

@@ -252,7 +252,7 @@ pub enum PhysicsError {
     #[error("the exact reduced run that makes the cubature's training poses diverged at t = {time} s; use exact forces")]
     CubatureTrainingDiverged { time: f64 },
     /// A full-space training run of a trained basis diverged.
-    #[error("the full-space training run of the trained basis ({case}) diverged at t = {time} s; narrow the training range (trainingScale, trainingTilt) or use another modeSelection")]
+    #[error("the full-space training run of the trained basis ({case}) diverged at t = {time} s; narrow the training range or choose another basis")]
     TrainingDiverged { case: String, time: f64 },
     /// Stored set-up data that does not fit the scene and solver.
     #[error("the stored set-up data does not fit the scene and solver: {what}")]

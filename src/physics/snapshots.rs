@@ -25,7 +25,7 @@
 //!
 //! **Range**: the box of the snapshots' coordinates q = Φᵀ M d
 //! ([`TrainedRange`]); the distance of a state from it is what
-//! `trainingRange` reports. With cubature forces the cubature trains on the
+//! [`super::Simulator::training_range`] reports. With cubature forces the cubature trains on the
 //! same snapshots ([`training::train`]).
 
 use faer::Mat;
