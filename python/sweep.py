@@ -71,7 +71,7 @@ def main(argv=None):
         default=None,
         metavar="NAME=VALUE",
         help="start value of a reference run (repeatable, e.g. --reference reduction=full --reference maxInternalStep=1e-4): "
-        "every run gets E and maxNodeError against it (docs/method.md section 6), and the plot shows E against run time",
+        "every run gets E and maxNodeError against it (docs/method.md section 6), and the error plot shows E over the predictability window (--twins) against run time",
     )
     p.add_argument(
         "--twins",
