@@ -257,3 +257,15 @@ def test_no_horizon_on_the_paper_sheet_the_window_is_the_whole_run(md, client):
     plain = sweep.run_sweep(fmu, axes, stop_time=0.2, progress=False, reference=reference)
     assert [r["run"] for r in plain] == [0, 1, "reference"]
     assert all(math.isnan(r["twinsE"]) and math.isnan(r["horizon"]) and r["E_window"] == r["E"] for r in plain)
+
+
+def test_start_offset_through_fmpy(default_fmu, md):
+    """startOffset as a swept start value: 0 is the canonical run bit for bit,
+    1e-7 m another run, beyond 1e-3 m and below 0 refused, naming it."""
+    axes = sweep.parse_grid(md, ["startOffset=0,1e-7,2e-3,-1e-9"])
+    rows = sweep.run_sweep(default_fmu, axes, stop_time=0.1, progress=False)
+    canonical = sweep.run_sweep(default_fmu, [], stop_time=0.1, progress=False)[0]
+    assert [r["status"] for r in rows] == ["ok", "ok", "error", "error"], [r["message"] for r in rows]
+    assert deterministic([rows[0]])[0] | {"startOffset": ""} == deterministic([canonical])[0] | {"startOffset": ""}
+    assert rows[1]["finalSag"] != canonical["finalSag"]
+    assert all("startOffset" in r["message"] for r in rows[2:])

@@ -70,6 +70,8 @@ INTERFACE = {
     "cubatureSprings": ("UInt64", "calculatedParameter", "fixed"),
     "modeFrequencies": ("Float64", "calculatedParameter", "fixed"),
     "springNeighbours": ("UInt64", "calculatedParameter", "fixed"),
+    "startOffset": ("Float64", "parameter", "fixed"),
+    "startSeed": ("UInt64", "parameter", "fixed"),
 }
 
 ENUMERATIONS = {
