@@ -8,12 +8,13 @@
 //! RUN and REFERENCE have one row per output time, the flattened node
 //! positions (D per node), comma-separated, no header and no time column;
 //! X0 is one row, x(0); M one row, one mass per node (equal masses when
-//! left out). Prints one line of JSON, `{"E": .., "max_node_error": ..}`,
-//! each number with 17 significant digits.
+//! left out). Prints one line of JSON, `{"E": .., "max_node_error": ..,
+//! "E_by_window": [..]}` (E over the first 1, 2, ... output times), each
+//! number with 17 significant digits.
 
 use std::path::PathBuf;
 
-use modal_mass_spring::measures::{max_node_error, trajectory_error, Masses};
+use modal_mass_spring::measures::{max_node_error, trajectory_error, trajectory_errors_by_window, Masses};
 
 struct Args {
     run: PathBuf,
@@ -62,7 +63,7 @@ fn read_row(path: &PathBuf) -> Result<Vec<f64>, String> {
     }
 }
 
-fn measure(args: &Args) -> Result<(f64, f64), String> {
+fn measure(args: &Args) -> Result<(f64, f64, Vec<f64>), String> {
     let run = read_rows(&args.run)?;
     let reference = read_rows(&args.reference)?;
     let start = read_row(&args.start)?;
@@ -82,7 +83,11 @@ fn measure(args: &Args) -> Result<(f64, f64), String> {
         Some(m) => Masses::PerNode { masses: m, dim: args.dim },
         None => Masses::Equal,
     };
-    Ok((trajectory_error(&run, &reference, &start, masses), max_node_error(&run, &reference, args.dim)))
+    Ok((
+        trajectory_error(&run, &reference, &start, masses),
+        max_node_error(&run, &reference, args.dim),
+        trajectory_errors_by_window(&run, &reference, &start, masses),
+    ))
 }
 
 /// `{:e}`: the shortest digits that parse back to the same f64 (at most 17
@@ -102,7 +107,10 @@ fn main() {
         std::process::exit(2)
     });
     match measure(&args) {
-        Ok((e, max_node)) => println!("{{\"E\": {}, \"max_node_error\": {}}}", json_number(e), json_number(max_node)),
+        Ok((e, max_node, windows)) => {
+            let windows: Vec<String> = windows.into_iter().map(json_number).collect();
+            println!("{{\"E\": {}, \"max_node_error\": {}, \"E_by_window\": [{}]}}", json_number(e), json_number(max_node), windows.join(", "))
+        }
         Err(e) => {
             eprintln!("trajectory_error: {e}");
             std::process::exit(1)

@@ -22,19 +22,29 @@ them); --serial runs them one after the other in this process, without Dask.
 A run the FMU refuses (a parameter out of range, a configuration set-up
 rejects, a diverging step) is a row with its status and the FMU's message.
 
+With --reference NAME=VALUE ... a reference run is added and every run gets
+its error E against it (docs/method.md section 6). --twins N (default 3) also
+runs N twins of the reference, started 1e-7 m away (startOffset, startSeed =
+1..N): the earliest time a twin's E over [0, T] reaches 1e-3 is the scene's
+predictability horizon T_p (cloth parts within a second; the paper's 2D sheet
+never), and every run gets E_window, its E over [0, T_p] (the whole run
+without a horizon), beside E and the twins' own E (their floor): on a chaotic
+scene E over the whole run measures the scene's sensitivity, not the model.
+
 The numbers of a run depend on its start values only: the same sweep gives the
 same CSV, bit for bit, serially or on any number of workers of this machine,
 except the columns wallTime and worker (see NONDETERMINISTIC).
 """
 
 import argparse
+import math
 import os
 import sys
 import time
 
 # The sweep's parts, one module per job in python/sweeping/; the names the
 # tests and other scripts use stay importable from here.
-from sweeping.driver import run_sweep
+from sweeping.driver import HORIZON_THRESHOLD, TWIN_OFFSET, run_sweep
 from sweeping.grid import METRICS, NONDETERMINISTIC, STEP, columns, experiment, grid_points, parse_grid  # noqa: F401 (METRICS, NONDETERMINISTIC)
 from sweeping.output import cell, write_csv, write_parquet
 from sweeping.plot import plot, plot_error
@@ -61,11 +71,22 @@ def main(argv=None):
         default=None,
         metavar="NAME=VALUE",
         help="start value of a reference run (repeatable, e.g. --reference reduction=full --reference maxInternalStep=1e-4): "
-        "every run gets E and maxNodeError against it (docs/method.md section 6), and the plot shows E against run time",
+        "every run gets E and maxNodeError against it (docs/method.md section 6), and the error plot shows E over the predictability window (--twins) against run time",
+    )
+    p.add_argument(
+        "--twins",
+        type=int,
+        default=3,
+        metavar="N",
+        help=f"with --reference: N twins of the reference started {TWIN_OFFSET:g} m away (startOffset, startSeed = 1..N) give the "
+        f"predictability horizon T_p (the earliest time a twin's E reaches {HORIZON_THRESHOLD:g}) and every run E over [0, T_p] "
+        "(E_window); 0: none (default: 3)",
     )
     p.add_argument("--no-plot", action="store_true")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     a = p.parse_args(argv)
+    if a.twins < 0:
+        p.error(f"--twins must be 0 or more, not {a.twins}")
 
     from fmpy import read_model_description
 
@@ -80,12 +101,17 @@ def main(argv=None):
             reference = {name: values[0] for name, values in parse_grid(md, a.reference)}
         except ValueError as e:
             p.error(str(e))
+    twins = a.twins if reference is not None else 0
+    if twins and not any(v.name == "startOffset" for v in md.modelVariables):
+        p.error(f"{a.fmu} has no parameter startOffset to start twins with: rebuild it (cargo xtask fmu) or pass --twins 0")
     n = len(grid_points(axes))
     grid = " x ".join(f"{name} ({len(v)})" for name, v in axes) or "the FMU's start values"
+    if reference is not None:
+        grid += ", a reference run" + (f" and {twins} twins of it" if twins else "")
     t0 = time.perf_counter()
     if a.serial:
         print(f"sweep: {n} runs of {grid}, serially")
-        rows = run_sweep(a.fmu, axes, a.stop_time, a.step, progress=not a.quiet, reference=reference)
+        rows = run_sweep(a.fmu, axes, a.stop_time, a.step, progress=not a.quiet, reference=reference, twins=twins)
     else:
         from distributed import Client, LocalCluster
 
@@ -100,7 +126,7 @@ def main(argv=None):
         print(f"sweep: {n} runs of {grid} on {where}")
         t0 = time.perf_counter()
         try:
-            rows = run_sweep(a.fmu, axes, a.stop_time, a.step, client=client, progress=not a.quiet, reference=reference)
+            rows = run_sweep(a.fmu, axes, a.stop_time, a.step, client=client, progress=not a.quiet, reference=reference, twins=twins)
         finally:
             client.close()
             if cluster is not None:
@@ -117,7 +143,7 @@ def main(argv=None):
         stop, step = experiment(md, a.stop_time, a.step)
         fixed = [f"{name}={cell(v[0])}" for name, v in axes if len(v) == 1]
         setting = ", ".join(fixed + [f"stop time {stop:g} s"] + ([] if STEP in dict(axes) else [f"step {step:g} s"]))
-        grid_rows = rows[:-1] if reference is not None else rows
+        grid_rows = [r for r in rows if isinstance(r["run"], int)]
         plot(stem + ".png", grid_rows, axes, f"{md.modelName}: {os.path.basename(a.fmu)}, {n} runs; {setting}")
         written.append(stem + ".png")
         if reference is not None:
@@ -127,11 +153,29 @@ def main(argv=None):
     counts = {}
     for r in rows:
         counts[r["status"]] = counts.get(r["status"], 0) + 1
-    print(f"sweep: {n} runs in {wall:.2f} s ({', '.join(f'{c} {s}' for s, c in sorted(counts.items()))}); wrote {', '.join(os.path.relpath(w) for w in written)}")
+    print(f"sweep: {len(rows)} runs in {wall:.2f} s ({', '.join(f'{c} {s}' for s, c in sorted(counts.items()))}); wrote {', '.join(os.path.relpath(w) for w in written)}")
     for r in rows:
         if r["status"] != "ok":
             print(f"  run {r['run']} ({', '.join(f'{k}={cell(r[k])}' for k, _ in axes)}): {r['status']}: {r['message']}")
+    if twins:
+        print(predictability_summary(rows[-1], twins, sum(1 for r in rows if str(r["run"]).startswith("twin") and r["status"] in ("ok", "warning"))))
     return 0
+
+
+def predictability_summary(ref, twins, completed):
+    """The horizon T_p and the twins' floor, in a sentence."""
+    start = f"predictability: {completed} of {twins} twins of the reference started {TWIN_OFFSET:g} m away completed"
+    if completed == 0 or math.isnan(ref["twinsE"]):
+        return f"{start}; no horizon known, E_window is E over the whole run"
+    if math.isnan(ref["horizon"]):
+        return (
+            f"{start}; no horizon within the run: their E stays below {HORIZON_THRESHOLD:g} "
+            f"(floor {ref['twinsE']:.3g} over the run), so E_window is E over the whole run"
+        )
+    return (
+        f"{start}; horizon T_p = {ref['horizon']:g} s (a twin's E over [0, T_p] reaches {HORIZON_THRESHOLD:g}); "
+        f"twins' floor {ref['twinsE_window']:.3g} over [0, T_p], {ref['twinsE']:.3g} over the run; E_window is E over [0, T_p]"
+    )
 
 
 if __name__ == "__main__":

@@ -21,6 +21,10 @@ METRICS = [
     "outputPoints",  # communication points after the start
     "E",  # error against the reference run (--reference), docs/method.md section 6; NaN without one
     "maxNodeError",  # m, the largest node distance from the reference over the output points
+    "E_window",  # E over [0, horizon]: the window in which the scene is predictable (the whole run without a horizon)
+    "horizon",  # s, the predictability horizon T_p: the earliest time a twin's E over [0, T_p] reaches 1e-3; NaN: none within the run (or no twins)
+    "twinsE",  # the twins' largest E over the whole run: the floor no model of the scene can be judged below; NaN without twins (--twins 0)
+    "twinsE_window",  # the twins' largest E over [0, horizon], the floor of E_window
     "message",  # the FMU's warnings and errors, or the exception of a refused run
 ]
 # Columns that differ from one execution of the same run to the next: left

@@ -54,8 +54,9 @@ def run_one(fmu_data, digest, point, stop_time, step, keep_positions=False):
     """Simulate one point of the grid with fmpy.simulate_fmu; returns its row
     (the point's values, then METRICS and NONDETERMINISTIC). With
     `keep_positions` the row also holds the node positions at every output
-    point (`_positions`) and before the first step (`_start`), for the error
-    against a reference; they are not written out."""
+    point (`_positions`), those times (`_times`) and the positions before the
+    first step (`_start`), for the error against a reference; they are not
+    written out."""
     from fmpy import read_model_description, simulate_fmu
     from fmpy.fmi1 import FMICallException
     from fmpy.fmi3 import FMU3Slave
@@ -90,6 +91,7 @@ def run_one(fmu_data, digest, point, stop_time, step, keep_positions=False):
             x = np.asarray(fmu.getFloat64([vr["positions"]], nValues=state["n"]))
             if keep_positions:
                 state.setdefault("frames", []).append(x)
+                state.setdefault("times", []).append(float(t))
             bottom_y = x[-state["nx"] * state["dim"] :][1 :: state["dim"]]
             state["sags"].append(state["rest"] - bottom_y.mean())
             return True
@@ -108,6 +110,7 @@ def run_one(fmu_data, digest, point, stop_time, step, keep_positions=False):
         sags = np.array(state["sags"])
         if keep_positions:
             row["_positions"] = np.array(state["frames"])
+            row["_times"] = state["times"]
             row["_start"] = start_positions(unzipdir, md, start_values)
             row["_dim"] = state["dim"]
         row.update(

@@ -21,8 +21,9 @@ use crate::physics::{SetupData, Simulator};
 /// File name under `resources/`.
 pub const FILE: &str = "setup.bin";
 const MAGIC: &[u8; 8] = b"MMSBAKE1";
-/// Fixed parameters the set-up of the basis and the cubature does not read.
-const NOT_READ_BY_SETUP: &[u32] = &[vr::INTEGRATOR, vr::MAX_INTERNAL_STEP];
+/// Fixed parameters the set-up of the basis and the cubature does not read
+/// (a twin's start moves the state after it).
+const NOT_READ_BY_SETUP: &[u32] = &[vr::INTEGRATOR, vr::MAX_INTERNAL_STEP, vr::START_OFFSET, vr::START_SEED];
 
 /// Tunable parameters and inputs whose values at set-up the basis reads.
 const SETUP_LOADS: &[u32] = &[vr::GRAVITY, vr::LOAD_X, vr::LOAD_Y, vr::LOAD_Z];

@@ -4,7 +4,7 @@
 //! `modelDescription/variables.toml` mean to [`crate::physics`], and the
 //! model's own rules, behind the [`Model`] interface the glue calls.
 //!
-//! - [`params`]: values -> grid, solver settings, loads, load node; the canonical scenes;
+//! - [`params`]: values -> grid, solver settings, loads, load node, a twin's start; the canonical scenes;
 //! - [`messages`]: physics errors as messages naming the variables;
 //! - [`bake`]: the baked set-up in `resources/setup.bin`;
 //! - [`snapshot`]: the simulator's part of a serialized FMU state;

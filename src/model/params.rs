@@ -1,11 +1,13 @@
 //! What the values of the variables mean to the physics: the grid, the
-//! solver settings, the loads and the load node, and the canonical scenes'
-//! start values.
+//! solver settings, the loads and the load node, the start of a twin, and
+//! the canonical scenes' start values.
 
 use crate::fmi::params::Params;
 use crate::fmi::variables::{index_of, vr, SCENES};
 use crate::options::{FixedNodes, ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction};
 use crate::physics::{Grid, Loads, PhysicsError, Settings, SetupData, Simulator, Training};
+use rand_chacha::rand_core::{RngCore, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
 impl Params {
     /// The start values of the canonical scene `name` (the `[scenes.NAME]`
@@ -118,12 +120,59 @@ impl Params {
         self.build_with(None)
     }
 
-    /// Set-up with the costly part taken from a baked `prebuilt` when given.
+    /// Set-up with the costly part taken from a baked `prebuilt` when given;
+    /// a twin (startOffset > 0) starts displaced ([`Params::twin_start`]).
     pub fn build_with(&self, prebuilt: Option<&SetupData>) -> Result<Simulator, PhysicsError> {
         let scene = self.grid().build()?;
         if self.load_node_problem().is_some() {
             return Err(PhysicsError::LoadNode { node: self.load_node(), held: self.load_node().is_some() });
         }
-        Simulator::with_setup(scene, &self.settings(), &self.loads(), prebuilt)
+        let mut sim = Simulator::with_setup(scene, &self.settings(), &self.loads(), prebuilt)?;
+        if let Some(dy) = self.twin_start(&sim) {
+            sim.displace(&dy)?;
+        }
+        Ok(sim)
     }
+
+    /// The displacement of the generalized coordinates that starts a twin
+    /// (`docs/method.md`, section 6), `None` for the canonical start
+    /// (startOffset = 0): every free node moved by startOffset in the
+    /// direction [`twin_offset`] draws from startSeed; in the modal space the
+    /// modal coordinates of that displacement, q = Phi^T M dy (the part the
+    /// basis holds).
+    pub fn twin_start(&self, sim: &Simulator) -> Option<Vec<f64>> {
+        let size = self.scalar(vr::START_OFFSET);
+        if size == 0.0 {
+            return None;
+        }
+        let scene = sim.scene();
+        let dy = twin_offset(scene.n_dofs(), scene.dim, size, self.scalar(vr::START_SEED) as u64);
+        match sim.setup_data() {
+            Some(modal) => {
+                let mut q = vec![0.0; modal.basis.r];
+                modal.basis.project_displacement(&scene.dof_mass, &dy, &mut q);
+                Some(q)
+            }
+            None => Some(dy),
+        }
+    }
+}
+
+/// The start of a twin in the free DOFs (`dim` per free node, in their
+/// order): every free node moved by `size` [m] in its own direction, a point
+/// of the cube [-1, 1]^dim drawn from ChaCha8 seeded with `seed` (each
+/// coordinate 53 random bits) and scaled to length `size`: the twins of
+/// `tests/predictability.rs`.
+pub fn twin_offset(dofs: usize, dim: usize, size: f64, seed: u64) -> Vec<f64> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut dy = vec![0.0; dofs];
+    for node in dy.chunks_exact_mut(dim) {
+        for d in node.iter_mut() {
+            *d = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+        }
+        // A draw of 0 in every coordinate leaves its node where it is.
+        let norm = node.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-300);
+        node.iter_mut().for_each(|d| *d = size * *d / norm);
+    }
+    dy
 }

@@ -1,8 +1,9 @@
 """The measures of docs/method.md section 6 in python/measures.py: the
-trajectory error E and the largest node distance error agree with the Rust
-example `trajectory_error` to 1e-12 relative on the same data (seeded random
-trajectories, unequal masses, a run offset by a constant vector whose E is
-known in closed form); Spearman's rank correlation on cases with known
+trajectory error E, E over growing windows and the largest node distance
+error agree with the Rust example `trajectory_error` to 1e-12 relative on the
+same data (seeded random trajectories, unequal masses, a run offset by a
+constant vector whose E is known in closed form); the predictability horizon
+and the twins' floor, and Spearman's rank correlation, on cases with known
 answers.
 
 The example is found as ``<target>/release/examples/trajectory_error``
@@ -21,7 +22,7 @@ import pytest
 from conftest import ROOT, on_ci, target_dir
 
 sys.path.insert(0, str(ROOT / "python"))
-from measures import max_node_error, ranks, spearman, trajectory_error  # noqa: E402
+from measures import max_node_error, predictability, ranks, spearman, trajectory_error, trajectory_errors_by_window  # noqa: E402
 
 RTOL = 1e-12
 
@@ -47,8 +48,9 @@ def write_rows(path, rows):
     return str(path)
 
 
-def rust_measures(binary, tmp_path, run, reference, start, dim, masses=None):
-    """(E, max node error) of the Rust example on the same data."""
+def rust_measures(binary, tmp_path, run, reference, start, dim, masses=None, windows=False):
+    """(E, max node error) of the Rust example on the same data, and E over
+    growing windows with `windows`."""
     k = len(run)
     args = [
         str(binary),
@@ -63,6 +65,8 @@ def rust_measures(binary, tmp_path, run, reference, start, dim, masses=None):
         args += ["--masses", write_rows(tmp_path / "masses.csv", np.reshape(masses, (1, -1)))]
     out = subprocess.run(args, capture_output=True, text=True, check=True, timeout=60)
     result = json.loads(out.stdout)
+    if windows:
+        return result["E"], result["max_node_error"], np.array(result["E_by_window"])
     return result["E"], result["max_node_error"]
 
 
@@ -179,3 +183,76 @@ def test_ranks():
     assert ranks([10, 20, 20, 20, 5]).tolist() == [2.0, 4.0, 4.0, 4.0, 1.0]
     assert ranks([3.0, 1.0, 2.0]).tolist() == [3.0, 1.0, 2.0]
     assert ranks([]).tolist() == []
+
+
+def two_nodes():
+    """Two nodes in 2D (the case of src/measures.rs's tests): the reference moves
+    node 0 by (3, 4) then (6, 8), node 1 by (0, 1) then (0, 2); the run is off
+    by (1, 0) on node 0 and (0, 1) on node 1 at t_1, and exact at t_2."""
+    start = np.array([0.0, 0.0, 1.0, 1.0])
+    reference = np.array([start, [3.0, 4.0, 1.0, 2.0], [6.0, 8.0, 1.0, 3.0]])
+    run = np.array([start, [4.0, 4.0, 1.0, 3.0], [6.0, 8.0, 1.0, 3.0]])
+    return run, reference, start
+
+
+def test_errors_by_window_have_their_known_values():
+    """0 / 0 before the reference moves; Σ differences² = 2 over Σ motion² = 26
+    after t_1, 130 after t_2; the last window is E; the run against itself is
+    0 once the reference has moved; a run that moves alone is infinitely off."""
+    run, reference, start = two_nodes()
+    w = trajectory_errors_by_window(run, reference, start, 2)
+    assert len(w) == 3 and math.isnan(w[0])
+    assert w[1] == pytest.approx(math.sqrt(2 / 26), rel=1e-15) and w[2] == pytest.approx(math.sqrt(2 / 130), rel=1e-15)
+    assert w[2] == trajectory_error(run, reference, start, 2)
+    assert np.isnan(trajectory_errors_by_window(reference, reference, start, 2)[0])
+    assert list(trajectory_errors_by_window(reference, reference, start, 2)[1:]) == [0.0, 0.0]
+    assert trajectory_errors_by_window(run, np.array([start] * 3), start, 2)[1] == math.inf
+    # masses weigh each node: 2 and 3 give (2·1 + 3·1) / (2·25 + 3·1) after t_1
+    assert trajectory_errors_by_window(run, reference, start, 2, masses=[2.0, 3.0])[1] == pytest.approx(math.sqrt(5 / 53), rel=1e-15)
+
+
+@pytest.mark.parametrize("seed,frames,nodes,dim", [(10, 40, 12, 2), (11, 25, 30, 3)])
+def test_errors_by_window_agree_with_rust(rust_error, tmp_path, seed, frames, nodes, dim):
+    run, reference, start = random_case(seed, frames, nodes, dim)
+    w = trajectory_errors_by_window(run, reference, start, dim)
+    _, _, w_rs = rust_measures(rust_error, tmp_path, run, reference, start, dim, windows=True)
+    print(f"seed {seed}: E over the first 1, {frames // 2}, {frames} output times {w[0]!r}, {w[frames // 2 - 1]!r}, {w[-1]!r}")
+    assert len(w_rs) == len(w) == frames
+    # the windows differ: E is no constant that a wrong window would reproduce
+    assert len(set(w.tolist())) == frames
+    np.testing.assert_allclose(w, w_rs, rtol=RTOL, atol=0.0)
+
+
+def test_predictability_known_answers():
+    """The horizon is the earliest output time at which any twin's E reaches
+    the threshold (reaching it exactly counts), the floor the largest last E."""
+    times = [0.1, 0.2, 0.3, 0.4]
+    slow, fast = [1e-5, 5e-4, 1e-3, 4e-3], [1e-4, 2e-3, 3e-3, 2e-3]
+    assert predictability(times, [slow, fast]) == (0.2, 4e-3)
+    assert predictability(times, [slow]) == (0.3, 4e-3)
+    assert predictability(times, [slow, fast], threshold=1e-2) == (None, 4e-3)
+    # NaN (the windows before the reference moves) reaches nothing
+    assert predictability(times, [[math.nan, 1e-4, 1e-3, 1e-3]]) == (0.3, 1e-3)
+    assert predictability(times, []) == (None, 0.0)
+    assert predictability([], [[]]) == (None, 0.0)
+
+
+def test_predictability_of_growing_twins():
+    """Twins whose distance from the reference grows like e^(t / τ) from d0
+    against a reference moving at speed v: E over [0, T] is known in closed
+    form, so the horizon is the first output time at which it passes 1e-3."""
+    t = np.arange(1, 201) * 0.01
+    v, d0, tau = 1.0, 1e-7, 0.1
+    start = np.zeros(2)
+    reference = np.stack([v * t, np.zeros_like(t)], axis=1)
+    twins, expected = [], []
+    for direction in ([0.0, 1.0], [0.6, 0.8]):
+        run = reference + np.outer(d0 * np.exp(t / tau), direction)
+        twins.append(trajectory_errors_by_window(run, reference, start, 2))
+        closed = np.sqrt(np.cumsum(d0**2 * np.exp(2 * t / tau)) / np.cumsum((v * t) ** 2))
+        # x − x_ref of positions near 1 m keeps about 1e-16 / 1e-7 of a 1e-7 m distance
+        np.testing.assert_allclose(twins[-1], closed, rtol=1e-8)
+        expected.append(t[np.argmax(closed >= 1e-3)])
+    horizon, floor = predictability(t, twins)
+    assert horizon == min(expected) and 0.5 < horizon < 2.0, horizon
+    assert floor == pytest.approx(max(w[-1] for w in twins), rel=0) and floor > 1e-3

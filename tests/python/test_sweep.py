@@ -182,3 +182,90 @@ def test_error_against_a_reference_run(default_fmu, md, client):
     errors = [r["E"] for r in serial[:-1]]
     print("E against full space at 1e-4 s, nModes = 2, 8, 32:", errors)
     assert all(np.isfinite(errors)) and errors[0] > errors[1] > errors[2] > 0.0
+
+
+CLOTH_12 = ["nx=12", "ny=12", "nModes=12"]
+
+
+def test_twins_find_the_cloth_horizon_and_the_window(tmp_path):
+    """Cloth 12 x 12 is chaotic: the three twins of the full-space reference,
+    started 1e-7 m away (the default --twins 3), part within a second; the
+    window [0, T_p] ends where the first of them reaches E = 1e-3, and a run
+    judged over it is judged on what the scene makes predictable: its
+    E_window is far below its E over the whole run, which the twins
+    themselves reach. Through the command line, serially."""
+    from conftest import fmu_path
+
+    fmu = fmu_path("cloth-3d")
+    out = tmp_path / "sweep.csv"
+    grid = CLOTH_12 + ["reduction=modal,full", "modeSelection=load", "integrator=newmark-implicit"]
+    args = [str(fmu), "--serial", "--quiet", "--out", str(out)]
+    args += [a for g in grid for a in ("--param", g)] + [a for r in CLOTH_12 + ["reduction=full"] for a in ("--reference", r)]
+    run = subprocess.run([sys.executable, str(ROOT / "python" / "sweep.py"), *args], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    summary = [l for l in run.stdout.splitlines() if l.startswith("predictability:")]
+    print(run.stdout)
+    rows = read_csv(out)
+    assert [r["run"] for r in rows] == ["0", "1", "twin1", "twin2", "twin3", "reference"]
+    assert all(r["status"] in ("ok", "warning") for r in rows), [r["message"] for r in rows]
+    num = lambda r, k: float(r[k])
+    horizon = num(rows[-1], "horizon")
+    assert 0.05 < horizon < 1.5, horizon
+    assert len(summary) == 1 and f"T_p = {horizon:g} s" in summary[0] and "3 of 3 twins" in summary[0], run.stdout
+    assert all(num(r, "horizon") == horizon for r in rows)
+    twins = rows[2:5]
+    # the twins are apart from the reference and from each other
+    assert len({r["E"] for r in twins}) == 3
+    floor, floor_window = num(rows[-1], "twinsE"), num(rows[-1], "twinsE_window")
+    assert floor == max(num(r, "E") for r in twins) and floor > 1e-2, floor
+    # the window ends at the first output time a twin's E reaches 1e-3: that twin is just past it there
+    assert floor_window == max(num(r, "E_window") for r in twins) and 1e-3 <= floor_window < 2e-3, floor_window
+    assert f"{floor_window:.3g}" in summary[0] and f"{floor:.3g}" in summary[0]
+    for r in rows[:2]:
+        e, e_window = num(r, "E"), num(r, "E_window")
+        print(f"run {r['run']} ({r['reduction']}): E {e:.3g}, E over [0, {horizon} s] {e_window:.3g}")
+        assert floor_window < e_window < e, (r["run"], e_window, e)
+    # the full-space run with the implicit scheme follows the reference until the scene parts them
+    assert num(rows[1], "E_window") < 0.2 * num(rows[1], "E")
+    assert out.with_name("sweep-error.png").stat().st_size > 10_000
+
+
+def test_no_horizon_on_the_paper_sheet_the_window_is_the_whole_run(md, client):
+    """paper-2d-top-row (the default FMU's scene) is regular: over the whole
+    default experiment (2 s) its twins stay near their 1e-7 m start, no
+    horizon, and E_window is E over the whole run, for every row; serially and
+    on the cluster, the same numbers."""
+    from conftest import fmu_path
+
+    fmu = str(fmu_path("paper-2d-top-row"))
+    axes = sweep.parse_grid(md, ["nModes=2,8"])
+    reference = {"reduction": "full"}
+    serial = sweep.run_sweep(fmu, axes, progress=False, reference=reference, twins=2)
+    on_cluster = sweep.run_sweep(fmu, axes, client=client, progress=False, reference=reference, twins=2)
+    assert deterministic(on_cluster) == deterministic(serial)
+    assert [r["run"] for r in serial] == [0, 1, "twin1", "twin2", "reference"]
+    ref = serial[-1]
+    print(f"paper-2d-top-row: twins' E over 2 s {ref['twinsE']:.3g}; E of nModes = 2, 8: {serial[0]['E']:.3g}, {serial[1]['E']:.3g}")
+    assert ref["finalTime"] == pytest.approx(2.0) and ref["outputPoints"] == 200
+    for r in serial:
+        assert math.isnan(r["horizon"]), r
+        assert r["E_window"] == r["E"] and r["twinsE_window"] == r["twinsE"]
+    assert 0.0 < ref["twinsE"] < 1e-4
+    assert serial[2]["E"] > 0.0 and serial[3]["E"] > 0.0 and serial[2]["E"] != serial[3]["E"]
+    assert serial[0]["E"] > serial[1]["E"] > ref["twinsE"]
+    # without twins there is no floor, and the window is the whole run
+    plain = sweep.run_sweep(fmu, axes, stop_time=0.2, progress=False, reference=reference)
+    assert [r["run"] for r in plain] == [0, 1, "reference"]
+    assert all(math.isnan(r["twinsE"]) and math.isnan(r["horizon"]) and r["E_window"] == r["E"] for r in plain)
+
+
+def test_start_offset_through_fmpy(default_fmu, md):
+    """startOffset as a swept start value: 0 is the canonical run bit for bit,
+    1e-7 m another run, beyond 1e-3 m and below 0 refused, naming it."""
+    axes = sweep.parse_grid(md, ["startOffset=0,1e-7,2e-3,-1e-9"])
+    rows = sweep.run_sweep(default_fmu, axes, stop_time=0.1, progress=False)
+    canonical = sweep.run_sweep(default_fmu, [], stop_time=0.1, progress=False)[0]
+    assert [r["status"] for r in rows] == ["ok", "ok", "error", "error"], [r["message"] for r in rows]
+    assert deterministic([rows[0]])[0] | {"startOffset": ""} == deterministic([canonical])[0] | {"startOffset": ""}
+    assert rows[1]["finalSag"] != canonical["finalSag"]
+    assert all("startOffset" in r["message"] for r in rows[2:])

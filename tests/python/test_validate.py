@@ -47,6 +47,11 @@ INTERFACE = {
     "anchorRX": ("Float64", "input", "continuous"),
     "anchorRY": ("Float64", "input", "continuous"),
     "anchorRZ": ("Float64", "input", "continuous"),
+    "trainingScale": ("Float64", "parameter", "fixed"),
+    "trainingTilt": ("Float64", "parameter", "fixed"),
+    "trainingTime": ("Float64", "parameter", "fixed"),
+    "trainingRangeLimit": ("Float64", "parameter", "tunable"),
+    "trainingRange": ("Float64", "output", "continuous"),
     "anchorMotion": ("Boolean", "parameter", "fixed"),
     "anchorRotation": ("Boolean", "parameter", "fixed"),
     "positions": ("Float64", "output", "continuous"),
@@ -70,13 +75,15 @@ INTERFACE = {
     "cubatureSprings": ("UInt64", "calculatedParameter", "fixed"),
     "modeFrequencies": ("Float64", "calculatedParameter", "fixed"),
     "springNeighbours": ("UInt64", "calculatedParameter", "fixed"),
+    "startOffset": ("Float64", "parameter", "fixed"),
+    "startSeed": ("UInt64", "parameter", "fixed"),
 }
 
 ENUMERATIONS = {
     "fixedNodes": ["top-row", "top-corners"],
     "reduction": ["modal", "full"],
     "integrator": ["newmark-explicit", "newmark-implicit", "trigonometric"],
-    "modeSelection": ["lowest", "load"],
+    "modeSelection": ["lowest", "load", "trained"],
     "linearization": ["rest", "equilibrium"],
 }
 
