@@ -16,7 +16,10 @@
 //!   and with the holder turning;
 //! - `residual_check/cloth-3d-NxN`: `fmi3DoStep` of the cloth with 16 modes
 //!   of the load, a static correction and cubature forces, as a host gets it
-//!   (the default `forceResidualLimit`) and with the check off, 0.01 s steps.
+//!   (the default `forceResidualLimit`) and with the check off, 0.01 s steps;
+//! - `trained/cloth-3d-NxN`: `fmi3DoStep` of the cloth with 16 trained
+//!   vectors (`modeSelection = trained`), exact and cubature forces, default
+//!   settings otherwise, without and with the node positions read after each step.
 //!
 //! cargo bench --bench step
 
@@ -198,20 +201,26 @@ fn do_step(c: &mut Criterion) {
 /// load, a static correction and cubature forces, `limit` its
 /// forceResidualLimit, initialized at t = 0.
 fn cloth_instance(n: u64, limit: f64) -> fmi3Instance {
+    cloth_with(n, &[(vr::MODE_SELECTION, 2), (vr::FORCE_EVALUATION, 2)], true, limit)
+}
+
+/// An instance of the cloth-3d scene on an n x n grid with 16 modes, the
+/// enumerations `choices`, a static correction if `correction`,
+/// forceResidualLimit `limit`, every other value at its default, initialized at t = 0.
+fn cloth_with(n: u64, choices: &[(u32, i64)], correction: bool, limit: f64) -> fmi3Instance {
     let (name, token) = (CString::new("bench").unwrap(), CString::new(INSTANTIATION_TOKEN).unwrap());
     let inst =
         unsafe { fmi3InstantiateCoSimulation(name.as_ptr(), token.as_ptr(), null(), false, false, false, false, null(), 0, null_mut(), Some(silent), None) };
     assert!(!inst.is_null());
     let ok = fmi3Status_fmi3OK;
-    let on = true;
     unsafe {
         for (r, v) in [(vr::NX, n), (vr::NY, n), (vr::DIMENSION, 3), (vr::N_MODES, 16), (vr::LOAD_COLUMN, n / 2)] {
             assert_eq!(fmi3SetUInt64(inst, &r, 1, &v, 1), ok);
         }
-        for (r, v) in [(vr::MODE_SELECTION, 2i64), (vr::FORCE_EVALUATION, 2)] {
+        for &(r, v) in choices {
             assert_eq!(fmi3SetInt64(inst, &r, 1, &v, 1), ok);
         }
-        assert_eq!(fmi3SetBoolean(inst, &vr::STATIC_CORRECTION, 1, &on, 1), ok);
+        assert_eq!(fmi3SetBoolean(inst, &vr::STATIC_CORRECTION, 1, &correction, 1), ok);
         for (r, v) in [(vr::AUX_STIFFNESS, 0.05), (vr::FORCE_RESIDUAL_LIMIT, limit)] {
             assert_eq!(fmi3SetFloat64(inst, &r, 1, &v, 1), ok);
         }
@@ -246,9 +255,46 @@ fn residual_check(c: &mut Criterion) {
     }
 }
 
+/// `fmi3DoStep` of 0.01 s on the cloth with 16 trained vectors, exact
+/// and cubature forces, every other value at its default (the residual
+/// check and the trained range's check on), as a host gets it; and with the
+/// node positions read after each step.
+fn trained(c: &mut Criterion) {
+    for n in [30u64, 100] {
+        let mut group = c.benchmark_group(format!("trained/cloth-3d-{n}x{n}"));
+        group.sample_size(10);
+        for (label, force) in [("exact", 1i64), ("cubature", 2)] {
+            let inst = cloth_with(n, &[(vr::MODE_SELECTION, 3), (vr::FORCE_EVALUATION, force)], false, 0.9);
+            let mut positions = vec![0.0; 3 * (n * n) as usize];
+            let (h, mut time) = (0.01, 0.0);
+            for read in [false, true] {
+                let id = if read { format!("{label}, positions read") } else { label.to_string() };
+                group.bench_function(id, |b| {
+                    b.iter_custom(|iters| {
+                        let (mut event, mut terminate, mut early, mut last) = (false, false, false, 0.0);
+                        let t = Instant::now();
+                        for _ in 0..iters {
+                            let status = unsafe { fmi3DoStep(inst, time, h, true, &mut event, &mut terminate, &mut early, &mut last) };
+                            assert!(status == fmi3Status_fmi3OK || status == fmi3Status_fmi3Warning);
+                            if read {
+                                let r = vr::POSITIONS;
+                                assert_eq!(unsafe { fmi3GetFloat64(inst, &r, 1, positions.as_mut_ptr(), positions.len()) }, fmi3Status_fmi3OK);
+                            }
+                            time += h;
+                        }
+                        t.elapsed()
+                    })
+                });
+            }
+            unsafe { fmi3FreeInstance(inst) };
+        }
+        group.finish();
+    }
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(2));
-    targets = do_step, internal_step, cubature, residual_check
+    targets = do_step, internal_step, cubature, residual_check, trained
 }
 criterion_main!(benches);
