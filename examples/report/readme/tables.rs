@@ -34,17 +34,17 @@ pub fn speedups(md: &mut String, rows: &[Row], scenes: &[&str]) {
                 }
                 Some((m, None)) => {
                     let _ =
-                        writeln!(md, "| {scene} | {limit} | {} | {:.2e} | {:.2e} | none as accurate | | | |", describe(m), m.error_resolved, m.run_s_per_sim_s);
+                        writeln!(md, "| {scene} | {limit} | {} | {:.2e} | {:.2e} | none as accurate | | | |", describe(m), m.error_window, m.run_s_per_sim_s);
                 }
                 Some((m, Some((f, ratio)))) => {
                     let _ = writeln!(
                         md,
                         "| {scene} | {limit} | {} | {:.2e} | {:.2e} | {} | {:.2e} | {:.2e} | {ratio:.2} |",
                         describe(m),
-                        m.error_resolved,
+                        m.error_window,
                         m.run_s_per_sim_s,
                         describe(f),
-                        f.error_resolved,
+                        f.error_window,
                         f.run_s_per_sim_s
                     );
                 }
@@ -87,7 +87,7 @@ pub fn integrators(md: &mut String, rows: &[Row], scenes: &[&str]) {
                             "| {scene} | {limit} | {} | {} | {:.2e} | {} | {:.2e} | {:.2e} | {full} | {ratio} | {steps} |",
                             short(name),
                             describe(m),
-                            m.error_resolved,
+                            m.error_window,
                             m.internal_steps,
                             m.run_s_per_sim_s,
                             m.step_s_per_sim_s
@@ -121,10 +121,10 @@ pub fn variants(md: &mut String, rows: &[Row], variants: &[Variant], scenes: &[&
             }
             let ran: Vec<&Row> = vr.iter().copied().filter(|r| !r.note.starts_with("not run")).collect();
             let failed = ran.iter().filter(|r| !r.stable).count();
-            let best = vr.iter().filter(|r| r.stable).map(|r| r.error_resolved).fold(f64::INFINITY, f64::min);
+            let best = vr.iter().filter(|r| r.stable).map(|r| r.error_window).fold(f64::INFINITY, f64::min);
             let fewest = |limit: f64| {
                 vr.iter()
-                    .filter(|r| r.stable && r.error_resolved <= limit)
+                    .filter(|r| r.stable && r.error_window <= limit)
                     .min_by(|a, b| a.modes.cmp(&b.modes).then(a.run_s_per_sim_s.total_cmp(&b.run_s_per_sim_s)))
                     .map(|r| format!("{}{} ({} {})", r.modes, if r.modes == r.dofs { " (all)" } else { "" }, short(r.integrator), r.step_label))
                     .unwrap_or_else(|| "-".into())
@@ -187,12 +187,12 @@ pub fn force_residual(md: &mut String, rows: &[Row], scenes: &[&str]) {
                 return "-".to_string();
             }
             let x: Vec<f64> = rs.iter().map(|r| f(r)).collect();
-            let y: Vec<f64> = rs.iter().map(|r| r.error_resolved).collect();
+            let y: Vec<f64> = rs.iter().map(|r| r.error_window).collect();
             format!("{:.2}", spearman(&as_in_csv(&x), &as_in_csv(&y)))
         };
         let fine: Vec<&Row> = rs.iter().copied().filter(|r| r.integrator == "newmark-explicit" && r.step_label == "1/1000").collect();
-        let below = rs.iter().filter(|r| r.force_residual_max < 0.5).map(|r| r.error_resolved).fold(f64::NAN, f64::max);
-        let above = rs.iter().filter(|r| r.force_residual_max > 0.9).map(|r| r.error_resolved).fold(f64::NAN, f64::min);
+        let below = rs.iter().filter(|r| r.force_residual_max < 0.5).map(|r| r.error_window).fold(f64::NAN, f64::max);
+        let above = rs.iter().filter(|r| r.force_residual_max > 0.9).map(|r| r.error_window).fold(f64::NAN, f64::min);
         let fmt = |x: f64| if x.is_finite() { format!("{x:.2e}") } else { "-".into() };
         let _ = writeln!(
             md,
