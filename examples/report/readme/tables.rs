@@ -166,7 +166,7 @@ pub fn force_residual(md: &mut String, rows: &[Row], scenes: &[&str]) {
         md,
         "\n## forceResidual against the true error\n\n`forceResidual` (docs/method.md, section 6) is read after every output frame \
          of every modal run; the CSV has its largest and mean value over the run (`force_residual_max`, `force_residual_mean`) \
-         beside E. How well it ranks runs by their true error: Spearman's rank correlation between each and E, over the stable \
+         beside E. How well it ranks runs by their true error (E over the window, `error_window`): Spearman's rank correlation between each and E, over the stable \
          leave-out runs of each scene (all variants, schemes and steps), and over the explicit ones at step 1/1000 alone, whose \
          error is nearly all the basis's (1 = same order, 0 = unrelated). The largest E among runs whose forceResidual stayed \
          below 0.5, and the smallest among runs where it passed 0.9 (the FMU's default warning level), say what a threshold on \

@@ -91,7 +91,7 @@ impl Fidelity {
             Some(x) => Target {
                 what,
                 goal,
-                measured: format!("E = {:.3} over {} s (whole run {:.3})", x.error_window, x.window_s, x.error),
+                measured: format!("E = {:.3} over {:.2} s (whole run {:.3})", x.error_window, x.window_s, x.error),
                 met: Some(x.error_window <= self.limit),
             },
         }

@@ -74,7 +74,7 @@ pub fn section(md: &mut String, rows: &[Row], twins: &[(String, Twins)], variant
         };
         let _ = write!(
             md,
-            "| {scene} | {} | {} | {} | {} | {by} |",
+            "| {scene} | {} | {} | {:.2} | {:.2} | {by} |",
             t.until_s.map_or("-".into(), |x| format!("{x:.2}")),
             sci(t.floor),
             r.resolved_until_s,
