@@ -1,4 +1,5 @@
 """Plots of the error-against-run-time study, one figure per scene: error
+(E over the window up to the scene's predictability horizon, `error_window`)
 against run time (log-log; full space in black, modal runs coloured by
 variant, marker by integrator), error against the number of modes (explicit
 and trigonometric runs at the shortest and longest step, coloured by variant) and error against
@@ -50,13 +51,18 @@ def f(r, column):
         return float("nan")
 
 
+def e(r):
+    """The headline E: over the window (older CSVs: the resolved window)."""
+    return f(r, "error_window") if "error_window" in r else f(r, "error_resolved")
+
+
 def leaves_out(r):
     return r["method"] == "modal" and int(r["modes"]) < int(r["dofs"])
 
 
 by_scene = defaultdict(list)
 for r in rows:
-    if r["stable"] == "true" and f(r, "error") > 0:
+    if r["stable"] == "true" and e(r) > 0:
         by_scene[r["scene"]].append(r)
 
 for scene, rs in by_scene.items():
@@ -67,7 +73,7 @@ for scene, rs in by_scene.items():
     order = {v: i for i, v in enumerate(["full"] + VARIANTS)}
     for (v, integ), pts in sorted(series.items(), key=lambda kv: (order.get(kv[0][0], 99), kv[0][1])):
         marker = "s" if v == "full" else MARKER.get(integ, "o")
-        a.loglog([f(p, "run_s_per_sim_s") for p in pts], [f(p, "error") for p in pts], marker, color=colour(v),
+        a.loglog([f(p, "run_s_per_sim_s") for p in pts], [e(p) for p in pts], marker, color=colour(v),
                  label=f"{v} {integ.replace('newmark-', '')}", alpha=0.75, markersize=5,
                  markerfacecolor="none" if integ == "newmark-implicit" else colour(v))
     modal = [r for r in rs if r["method"] == "modal" and r["integrator"] in ("newmark-explicit", "trigonometric")]
@@ -80,24 +86,24 @@ for scene, rs in by_scene.items():
                             key=lambda p: int(p["modes"]))
                 if sp:
                     trig = integ == "trigonometric"
-                    b.loglog([int(p["modes"]) for p in sp], [f(p, "error") for p in sp],
+                    b.loglog([int(p["modes"]) for p in sp], [e(p) for p in sp],
                              ("D" if trig else "o" if k == 0 else "s") + (":" if trig else "-" if k == 0 else "--"), color=colour(v),
                              label=f"{v} {integ.replace('newmark-', '')} step {step}", alpha=0.8, markersize=4)
     fr = [r for r in rs if leaves_out(r) and np.isfinite(f(r, "force_residual_max"))]
     for v in sorted({variant(r) for r in fr}, key=lambda v: order.get(v, 99)):
         pts = [r for r in fr if variant(r) == v and f(r, "force_residual_max") > 0]
-        c.loglog([f(p, "force_residual_max") for p in pts], [f(p, "error_resolved") for p in pts], "o", color=colour(v), label=v, alpha=0.7, markersize=5)
-    rho = spearman([f(r, "force_residual_max") for r in fr], [f(r, "error_resolved") for r in fr])
+        c.loglog([f(p, "force_residual_max") for p in pts], [e(p) for p in pts], "o", color=colour(v), label=v, alpha=0.7, markersize=5)
+    rho = spearman([f(r, "force_residual_max") for r in fr], [e(r) for r in fr])
     a.set_xlabel("run time per simulated second (s)")
-    a.set_ylabel("trajectory error E")
+    a.set_ylabel("trajectory error E over the window")
     a.set_title(f"{scene}: error against run time")
     a.legend(fontsize=6, ncol=2)
     b.set_xlabel("modes kept r")
-    b.set_ylabel("trajectory error E")
+    b.set_ylabel("trajectory error E over the window")
     b.set_title(f"{scene}: error against modes (explicit, trigonometric)")
     b.legend(fontsize=6, ncol=2)
     c.set_xlabel("largest forceResidual over the run")
-    c.set_ylabel("trajectory error E (resolved window)")
+    c.set_ylabel("trajectory error E over the window")
     c.set_title(f"{scene}: E against forceResidual (Spearman {rho:.2f})")
     c.legend(fontsize=6)
     for ax in (a, b, c):
@@ -113,13 +119,13 @@ for ax, column, name in zip(axes, ["force_residual_max", "force_residual_mean"],
     xs, ys = [], []
     for i, (scene, rs) in enumerate(by_scene.items()):
         pts = [r for r in rs if leaves_out(r) and np.isfinite(f(r, column))]
-        x, y = [f(p, column) for p in pts], [f(p, "error_resolved") for p in pts]
+        x, y = [f(p, column) for p in pts], [e(p) for p in pts]
         xs += x
         ys += y
         ax.loglog([a for a in x if a > 0], [b for a, b in zip(x, y) if a > 0], "o", color=cmap[i % len(cmap)], alpha=0.6, markersize=4,
                   label=f"{scene} (ρ = {spearman(x, y):.2f}, {len(x)} runs)")
     ax.set_xlabel(f"{name} forceResidual over the run")
-    ax.set_ylabel("trajectory error E (resolved window)")
+    ax.set_ylabel("trajectory error E over the window")
     ax.set_title(f"E against the {name} forceResidual, leave-out runs (Spearman {spearman(xs, ys):.2f})")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)

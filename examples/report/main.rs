@@ -14,6 +14,7 @@
 //! Both are for trying the study out: the report they write is partial.
 //! `--log` prints every run as it ends (set-up and run time, E).
 
+mod fidelity;
 mod measure;
 mod plan;
 mod readme;
@@ -92,7 +93,8 @@ fn main() {
 
     // Every way of running each scene.
     let plans: Vec<Vec<plan::Plan>> = cases.iter().map(|case| plan_scene(&case.params, &variants, quick, variants_only)).collect();
-    let total: usize = plans.iter().map(|l| l.len() + 3).sum();
+    // Each scene's runs, its reference and its two checks, the twins' base run and the twins.
+    let total: usize = plans.iter().map(|l| l.len() + 4 + fidelity::TWIN_SEEDS.len()).sum();
     let bar = ProgressBar::new(total as u64);
     bar.set_style(ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {msg}").unwrap().progress_chars("=> "));
 
@@ -100,11 +102,12 @@ fn main() {
     let conditions = Conditions { seconds, repeats, budget_s, log, variants: &variants, bar: &bar, started };
     let mut rows: Vec<Row> = Vec::new();
     let mut reference_notes = String::new();
+    let mut twins = Vec::new();
     for (case, list) in cases.iter().zip(plans) {
-        measure_scene(&conditions, case, list, &reference_step, &mut rows, &mut reference_notes);
+        twins.push((case.label.clone(), measure_scene(&conditions, case, list, &reference_step, &mut rows, &mut reference_notes)));
     }
     bar.finish_with_message("done");
-    let study = Study { rows: &rows, variants: &variants, quick, seconds, repeats, budget_s, wall_s: started.elapsed().as_secs_f64() };
+    let study = Study { rows: &rows, twins: &twins, variants: &variants, quick, seconds, repeats, budget_s, wall_s: started.elapsed().as_secs_f64() };
     write_csv(&out, &rows).expect("cannot write the CSV");
     write_readme(&out, &study, &reference_notes);
 }

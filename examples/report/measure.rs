@@ -9,6 +9,7 @@ use indicatif::ProgressBar;
 use modal_mass_spring::measures::{max_node_error, median, trajectory_error, trajectory_errors_by_window, Masses};
 use modal_mass_spring::physics::*;
 
+use crate::fidelity::{coarse, deviation, twins, Twins};
 use crate::plan::{full_solver, Plan, SceneCase, Variant, FRAME, REFERENCE_MARGIN};
 use crate::row::{describe, Row};
 use crate::run::{run, set_up, simulate, Prepared};
@@ -32,10 +33,10 @@ pub struct Conditions<'a> {
     pub started: Instant,
 }
 
-/// Runs the reference of `case` at `reference_dt(free DOFs)` and every run
-/// of `list`, appends a row per run to `rows` and the reference's line of
-/// the References table to `notes`.
-pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, reference_dt: &dyn Fn(usize) -> f64, rows: &mut Vec<Row>, notes: &mut String) {
+/// Runs the reference of `case` at `reference_dt(free DOFs)`, the scene's
+/// twins and every run of `list`, appends a row per run to `rows` and the
+/// reference's line of the References table to `notes`; returns the twins.
+pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, reference_dt: &dyn Fn(usize) -> f64, rows: &mut Vec<Row>, notes: &mut String) -> Twins {
     let Conditions { seconds, repeats, budget_s, log, variants, bar, started } = *s;
     let p = &case.params;
     let n = p.build().unwrap().n_dofs();
@@ -53,6 +54,9 @@ pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, referenc
     let self_by_window = trajectory_errors_by_window(&reference.frames, &halved.frames, &halved.frames[0], Masses::Equal);
     let self_error = *self_by_window.last().unwrap();
     let halved_error = trajectory_error(&halved.frames, &quartered.frames, &quartered.frames[0], Masses::Equal);
+    bar.set_message(format!("{}: twins", case.label));
+    let twins = twins(p, seconds, &|| bar.inc(1));
+    let reference_coarse = coarse(p, &reference.frames, &reference.readings);
     let mut run_by_window: Vec<Vec<f64>> = Vec::new();
     let first = rows.len();
     // Full-space trajectories by (integrator, step), for the vs_full column.
@@ -125,6 +129,14 @@ pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, referenc
             force_residual_mean: f64::NAN,
             springs_visited: None,
             note: plan.note.clone(),
+            error_window: f64::NAN,
+            window_s: f64::NAN,
+            predictable_until_s: twins.until_s.unwrap_or(f64::NAN),
+            twin_floor: twins.floor,
+            force_vs_twins: f64::NAN,
+            bottom_vs_twins: f64::NAN,
+            kinetic_vs_twins: f64::NAN,
+            potential_vs_twins: f64::NAN,
         };
         let by_window = match result {
             Ok(t) => {
@@ -140,6 +152,8 @@ pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, referenc
                 row.force_residual_mean = t.force_residual_mean;
                 row.springs_visited = t.springs_visited;
                 row.stable = e.is_finite();
+                let d = deviation(&coarse(p, &t.frames, &t.readings), &reference_coarse);
+                [row.force_vs_twins, row.bottom_vs_twins, row.kinetic_vs_twins, row.potential_vs_twins] = std::array::from_fn(|o| d[o] / twins.spread[o]);
                 if method == "full" && plan.note.is_empty() {
                     full_runs.push((s.integrator, plan.step_label.clone(), t.frames));
                 } else if let Some((_, _, f)) = full_runs.iter().find(|(i, l, _)| *i == s.integrator && *l == plan.step_label) {
@@ -180,9 +194,14 @@ pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, referenc
         .collect();
     let resolved = (2..=self_by_window.len()).take_while(|&k| REFERENCE_MARGIN * self_by_window[k - 1] <= smallest_by_window[k - 1]).last().unwrap_or(1);
     let resolved_until_s = (resolved - 1) as f64 * FRAME;
+    // The headline window: up to the predictability horizon, within the resolved window.
+    let window_s = twins.until_s.map_or(resolved_until_s, |t| t.min(resolved_until_s));
+    let window = (window_s / FRAME).round() as usize;
     for (row, w) in rows[first..].iter_mut().zip(&run_by_window) {
         row.resolved_until_s = resolved_until_s;
         row.error_resolved = w.get(resolved - 1).copied().unwrap_or(f64::NAN);
+        row.window_s = window_s;
+        row.error_window = w.get(window).copied().unwrap_or(f64::NAN);
     }
     let self_error_resolved = self_by_window[resolved - 1];
     let smallest = rows[first..].iter().filter(|r| r.stable).map(|r| r.error).fold(f64::INFINITY, f64::min);
@@ -194,4 +213,5 @@ pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, referenc
         smallest / self_error,
         smallest_resolved / self_error_resolved
     );
+    twins
 }

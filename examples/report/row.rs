@@ -47,9 +47,39 @@ pub struct Row {
     #[serde(serialize_with = "sci7")]
     pub step_s_per_sim_s: f64,
     pub note: String,
+    /// E over [0, `window_s`]: the headline E of the run (see [`crate::fidelity`]).
+    #[serde(serialize_with = "sci7")]
+    pub error_window: f64,
+    /// The shorter of the scene's predictability horizon and the window the
+    /// reference resolves [s].
+    #[serde(serialize_with = "shortest")]
+    pub window_s: f64,
+    /// The scene's predictability horizon T_p (NaN: the twins stay within
+    /// [`crate::fidelity::PREDICTABLE_E`] over the whole run) [s].
+    #[serde(serialize_with = "shortest")]
+    pub predictable_until_s: f64,
+    /// The scene's twins' largest E over the whole run.
+    #[serde(serialize_with = "sci7")]
+    pub twin_floor: f64,
+    /// Per coarse observable ([`crate::fidelity::OBSERVABLES`]): the run's
+    /// deviation from the reference over the whole run, over the twins' spread.
+    #[serde(serialize_with = "sci7")]
+    pub force_vs_twins: f64,
+    #[serde(serialize_with = "sci7")]
+    pub bottom_vs_twins: f64,
+    #[serde(serialize_with = "sci7")]
+    pub kinetic_vs_twins: f64,
+    #[serde(serialize_with = "sci7")]
+    pub potential_vs_twins: f64,
 }
 
 impl Row {
+    /// The run's deviations from the reference over the twins' spread, in
+    /// the order of [`crate::fidelity::OBSERVABLES`].
+    pub fn vs_twins(&self) -> [f64; 4] {
+        [self.force_vs_twins, self.bottom_vs_twins, self.kinetic_vs_twins, self.potential_vs_twins]
+    }
+
     /// A modal run that leaves modes out.
     pub fn leaves_out(&self) -> bool {
         self.method == "modal" && self.modes < self.dofs

@@ -4,10 +4,13 @@ use std::time::Instant;
 
 use modal_mass_spring::physics::*;
 
+use crate::fidelity::{read, Reading};
 use crate::plan::FRAME;
 
 pub struct Trajectory {
     pub frames: Vec<Vec<f64>>,
+    /// The holder's force and the energies at the same times (not timed).
+    pub readings: Vec<Reading>,
     pub setup_s: f64,
     /// Wall time of each timed run [s].
     pub run_s: Vec<f64>,
@@ -58,6 +61,8 @@ pub fn run(prep: &mut Prepared, h: f64, seconds: f64, budget_s: f64, repeats: us
         sim.restore(&prep.start).map_err(|e| e.to_string())?;
         let mut frames = Vec::with_capacity(n_frames + 1);
         frames.push(sim.positions().to_vec());
+        let mut readings = Vec::with_capacity(n_frames + 1);
+        readings.push(read(sim));
         let (mut internal_steps, mut fr_max, mut fr_sum, mut untimed, mut reading) = (0, 0.0f64, 0.0, 0.0, 0.0);
         let t1 = Instant::now();
         for _ in 0..n_frames {
@@ -71,9 +76,11 @@ pub fn run(prep: &mut Prepared, h: f64, seconds: f64, budget_s: f64, repeats: us
             let t3 = Instant::now();
             frames.push(sim.positions().to_vec());
             reading += t3.elapsed().as_secs_f64();
-            // forceResidual visits every spring: read for the study, not timed.
+            // forceResidual and the potential energy visit every spring:
+            // read for the study, not timed.
             let t2 = Instant::now();
             let fr = sim.force_residual();
+            readings.push(read(sim));
             untimed += t2.elapsed().as_secs_f64();
             fr_max = fr_max.max(fr);
             fr_sum += fr;
@@ -81,14 +88,15 @@ pub fn run(prep: &mut Prepared, h: f64, seconds: f64, budget_s: f64, repeats: us
         let elapsed = t1.elapsed().as_secs_f64() - untimed;
         run_s.push(elapsed);
         step_s.push(elapsed - reading);
-        last = Some((frames, internal_steps / (per_frame * n_frames).max(1), fr_max, fr_sum / n_frames.max(1) as f64));
+        last = Some((frames, readings, internal_steps / (per_frame * n_frames).max(1), fr_max, fr_sum / n_frames.max(1) as f64));
         if elapsed > TIME_ONCE_S {
             break;
         }
     }
-    let (frames, internal_steps, force_residual_max, force_residual_mean) = last.unwrap();
+    let (frames, readings, internal_steps, force_residual_max, force_residual_mean) = last.unwrap();
     Ok(Trajectory {
         frames,
+        readings,
         setup_s: prep.setup_s,
         run_s,
         step_s,

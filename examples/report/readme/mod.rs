@@ -3,11 +3,13 @@
 mod scenes;
 mod tables;
 mod targets;
+mod twins;
 
 use std::fmt::Write as _;
 
 use modal_mass_spring::physics::ForceEvaluation;
 
+use crate::fidelity::Twins;
 use crate::plan::{Variant, FRAME, REFERENCE_MARGIN};
 use crate::row::Row;
 use crate::run::TIME_ONCE_S;
@@ -15,6 +17,8 @@ use crate::run::TIME_ONCE_S;
 /// What the README reports: the rows and how they were measured.
 pub struct Study<'a> {
     pub rows: &'a [Row],
+    /// Each scene's twins, by scene.
+    pub twins: &'a [(String, Twins)],
     pub variants: &'a [Variant],
     pub quick: bool,
     pub seconds: f64,
@@ -27,7 +31,7 @@ pub struct Study<'a> {
 /// variants, the references (`reference_notes`: one table line per scene),
 /// the speed-up and side-by-side tables and each scene's Pareto front.
 pub fn write_readme(out: &str, study: &Study, reference_notes: &str) {
-    let Study { rows, variants, quick, seconds, repeats, budget_s, wall_s } = *study;
+    let Study { rows, twins, variants, quick, seconds, repeats, budget_s, wall_s } = *study;
     let mut md = String::new();
     let _ = writeln!(md, "# Error against run time\n");
     let _ = writeln!(
@@ -38,10 +42,13 @@ pub fn write_readme(out: &str, study: &Study, reference_notes: &str) {
          going after {budget_s} s of wall time is stopped and listed as over budget. Error E is docs/method.md, section 6 against a \
          full-space explicit Newmark reference at a tiny step; output times every {FRAME} s. A run reads the node positions at every output \
          time, as a host that draws or couples them would, and nothing else: outputs nobody reads are not computed \
-         (`forceResidual`, which visits every spring, is read at the output times for the study outside the timing). \
+         (`forceResidual`, the holder's force and the energies, which the study reads at the output times, are read outside \
+         the timing). \
          `vs_full` in the CSV is E of a modal \
-         run against the full-space run with the same integrator and step. Speed-ups, mode counts and targets judge E over the \
-         window the reference resolves (`error_resolved`, see References; the whole run except on cloth-3d-100x100).\n",
+         run against the full-space run with the same integrator and step. E (`error_window`; speed-ups, mode counts, targets, Pareto \
+         fronts) is E over the window up to the scene's predictability horizon T_p, within the window the reference \
+         resolves (see Predictability and References); the whole run's E (`error`) is given beside it and the twins' \
+         floor.\n",
         if quick { " --quick" } else { "" },
         std::env::var("REPORT_DATE").unwrap_or_else(|_| "an unstated date".into()),
         std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
@@ -101,8 +108,7 @@ pub fn write_readme(out: &str, study: &Study, reference_notes: &str) {
     );
     let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
     scenes.dedup();
-    let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
-    scenes.dedup();
+    twins::section(&mut md, rows, twins, variants, &scenes);
     tables::speedups(&mut md, rows, &scenes);
     tables::integrators(&mut md, rows, &scenes);
     tables::variants(&mut md, rows, variants, &scenes);

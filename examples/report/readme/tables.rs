@@ -34,17 +34,17 @@ pub fn speedups(md: &mut String, rows: &[Row], scenes: &[&str]) {
                 }
                 Some((m, None)) => {
                     let _ =
-                        writeln!(md, "| {scene} | {limit} | {} | {:.2e} | {:.2e} | none as accurate | | | |", describe(m), m.error_resolved, m.run_s_per_sim_s);
+                        writeln!(md, "| {scene} | {limit} | {} | {:.2e} | {:.2e} | none as accurate | | | |", describe(m), m.error_window, m.run_s_per_sim_s);
                 }
                 Some((m, Some((f, ratio)))) => {
                     let _ = writeln!(
                         md,
                         "| {scene} | {limit} | {} | {:.2e} | {:.2e} | {} | {:.2e} | {:.2e} | {ratio:.2} |",
                         describe(m),
-                        m.error_resolved,
+                        m.error_window,
                         m.run_s_per_sim_s,
                         describe(f),
-                        f.error_resolved,
+                        f.error_window,
                         f.run_s_per_sim_s
                     );
                 }
@@ -87,7 +87,7 @@ pub fn integrators(md: &mut String, rows: &[Row], scenes: &[&str]) {
                             "| {scene} | {limit} | {} | {} | {:.2e} | {} | {:.2e} | {:.2e} | {full} | {ratio} | {steps} |",
                             short(name),
                             describe(m),
-                            m.error_resolved,
+                            m.error_window,
                             m.internal_steps,
                             m.run_s_per_sim_s,
                             m.step_s_per_sim_s
@@ -121,10 +121,10 @@ pub fn variants(md: &mut String, rows: &[Row], variants: &[Variant], scenes: &[&
             }
             let ran: Vec<&Row> = vr.iter().copied().filter(|r| !r.note.starts_with("not run")).collect();
             let failed = ran.iter().filter(|r| !r.stable).count();
-            let best = vr.iter().filter(|r| r.stable).map(|r| r.error_resolved).fold(f64::INFINITY, f64::min);
+            let best = vr.iter().filter(|r| r.stable).map(|r| r.error_window).fold(f64::INFINITY, f64::min);
             let fewest = |limit: f64| {
                 vr.iter()
-                    .filter(|r| r.stable && r.error_resolved <= limit)
+                    .filter(|r| r.stable && r.error_window <= limit)
                     .min_by(|a, b| a.modes.cmp(&b.modes).then(a.run_s_per_sim_s.total_cmp(&b.run_s_per_sim_s)))
                     .map(|r| format!("{}{} ({} {})", r.modes, if r.modes == r.dofs { " (all)" } else { "" }, short(r.integrator), r.step_label))
                     .unwrap_or_else(|| "-".into())
@@ -166,7 +166,7 @@ pub fn force_residual(md: &mut String, rows: &[Row], scenes: &[&str]) {
         md,
         "\n## forceResidual against the true error\n\n`forceResidual` (docs/method.md, section 6) is read after every output frame \
          of every modal run; the CSV has its largest and mean value over the run (`force_residual_max`, `force_residual_mean`) \
-         beside E. How well it ranks runs by their true error: Spearman's rank correlation between each and E, over the stable \
+         beside E. How well it ranks runs by their true error (E over the window, `error_window`): Spearman's rank correlation between each and E, over the stable \
          leave-out runs of each scene (all variants, schemes and steps), and over the explicit ones at step 1/1000 alone, whose \
          error is nearly all the basis's (1 = same order, 0 = unrelated). The largest E among runs whose forceResidual stayed \
          below 0.5, and the smallest among runs where it passed 0.9 (the FMU's default warning level), say what a threshold on \
@@ -187,12 +187,12 @@ pub fn force_residual(md: &mut String, rows: &[Row], scenes: &[&str]) {
                 return "-".to_string();
             }
             let x: Vec<f64> = rs.iter().map(|r| f(r)).collect();
-            let y: Vec<f64> = rs.iter().map(|r| r.error_resolved).collect();
+            let y: Vec<f64> = rs.iter().map(|r| r.error_window).collect();
             format!("{:.2}", spearman(&as_in_csv(&x), &as_in_csv(&y)))
         };
         let fine: Vec<&Row> = rs.iter().copied().filter(|r| r.integrator == "newmark-explicit" && r.step_label == "1/1000").collect();
-        let below = rs.iter().filter(|r| r.force_residual_max < 0.5).map(|r| r.error_resolved).fold(f64::NAN, f64::max);
-        let above = rs.iter().filter(|r| r.force_residual_max > 0.9).map(|r| r.error_resolved).fold(f64::NAN, f64::min);
+        let below = rs.iter().filter(|r| r.force_residual_max < 0.5).map(|r| r.error_window).fold(f64::NAN, f64::max);
+        let above = rs.iter().filter(|r| r.force_residual_max > 0.9).map(|r| r.error_window).fold(f64::NAN, f64::min);
         let fmt = |x: f64| if x.is_finite() { format!("{x:.2e}") } else { "-".into() };
         let _ = writeln!(
             md,
