@@ -5,7 +5,7 @@
 //! did not run (set after set-up), with exact and cubature forces, and the
 //! trainingRange indicator; then the set-up cost and the run time.
 //!
-//! `cargo run --release --example trained -- [--nx N] [--modes R]... [--seconds T]`
+//! `cargo run --release --example trained -- [--nx N] [--modes R]... [--seconds T] [--variant NAME]...`
 
 use std::time::Instant;
 
@@ -65,6 +65,7 @@ fn main() {
             m
         }
     };
+    let only: Vec<String> = args.iter().enumerate().filter(|(_, a)| *a == "--variant").map(|(i, _)| args[i + 1].clone()).collect();
     let base = scenes::cloth(nx, nx);
     let cases = [
         ("canonical", gravity(1.0, 0.0, 0.0)),
@@ -83,6 +84,9 @@ fn main() {
             ("trained+cubature", ModeSelection::Trained, false, ForceEvaluation::Cubature),
             ("load+static", ModeSelection::Load, true, ForceEvaluation::Exact),
         ] {
+            if !only.is_empty() && !only.iter().any(|o| o == name) {
+                continue;
+            }
             let settings = Settings {
                 mode_selection: selection,
                 static_correction: correction,

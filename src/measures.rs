@@ -1,10 +1,14 @@
 //! Measures of a run against a reference (`docs/method.md`, section 6),
 //! written once for the study, the examples and the tests: the trajectory
 //! error E, over the whole run or over growing windows of it, the largest
-//! node distance error, the median and Spearman's rank correlation.
+//! node distance error, the median and Spearman's rank correlation, and
+//! the seeded start of a twin run and the predictability horizon it gives.
 //!
 //! A trajectory is a slice of frames, one per output time t_k, each the
 //! flattened node positions (`dim` coordinates per node).
+
+use rand_chacha::rand_core::{RngCore, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
 /// The node masses m_i of E.
 #[derive(Clone, Copy, Debug, Default)]
@@ -76,6 +80,25 @@ pub fn predictability(times: &[f64], twins: &[Vec<f64>], threshold: f64) -> (Opt
         twins.iter().filter_map(|e| e.iter().position(|&x| x >= threshold).map(|k| times[k])).fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.min(t))));
     let floor = twins.iter().filter_map(|e| e.last().copied()).fold(0.0, f64::max);
     (horizon, floor)
+}
+
+/// The start of a twin in the free DOFs (`dim` per free node, in their
+/// order): every free node moved by `size` [m] in its own direction, a point
+/// of the cube [-1, 1]^dim drawn from ChaCha8 seeded with `seed` (each
+/// coordinate 53 random bits) and scaled to length `size`: the twins of
+/// the study, the tests and the FMU's `startOffset`.
+pub fn twin_offset(dofs: usize, dim: usize, size: f64, seed: u64) -> Vec<f64> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut dy = vec![0.0; dofs];
+    for node in dy.chunks_exact_mut(dim) {
+        for d in node.iter_mut() {
+            *d = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+        }
+        // A draw of 0 in every coordinate leaves its node where it is.
+        let norm = node.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-300);
+        node.iter_mut().for_each(|d| *d = size * *d / norm);
+    }
+    dy
 }
 
 /// The largest distance between a node and its reference position over all

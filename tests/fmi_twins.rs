@@ -9,7 +9,7 @@ mod common;
 
 use common::*;
 use modal_mass_spring::fmi::variables::vr;
-use modal_mass_spring::model::params::twin_offset;
+use modal_mass_spring::measures::twin_offset;
 use modal_mass_spring::model::Params;
 use modal_mass_spring::physics::Simulator;
 

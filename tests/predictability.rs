@@ -6,11 +6,9 @@
 //! the perturbation. E measured on either over the whole run says as much
 //! about the scene as about any model.
 
-use modal_mass_spring::measures::{predictability, trajectory_errors_by_window, Masses};
+use modal_mass_spring::measures::{predictability, trajectory_errors_by_window, twin_offset, Masses};
 use modal_mass_spring::physics::*;
 use modal_mass_spring::scenes::{self, Setup};
-use rand_chacha::rand_core::{RngCore, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 
 const H: f64 = 0.01;
 
@@ -30,21 +28,6 @@ fn run(setup: &Setup, steps: usize, kick: Option<&[f64]>) -> (Vec<f64>, Vec<Vec<
     (start, frames)
 }
 
-/// Every free node moved by a random direction times `size` [m].
-fn nudge(dofs: usize, dim: usize, size: f64, seed: u64) -> Vec<f64> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut u = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
-    let mut dy = vec![0.0; dofs];
-    for node in dy.chunks_exact_mut(dim) {
-        let v: Vec<f64> = (0..dim).map(|_| u()).collect();
-        let n = v.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-300);
-        for (d, x) in node.iter_mut().zip(&v) {
-            *d = size * x / n;
-        }
-    }
-    dy
-}
-
 /// (horizon, twins' floor at the end) of `setup` in full space over `steps` steps, 3 twins.
 fn horizon(setup: Setup, steps: usize) -> (Option<f64>, f64) {
     let setup = setup.with_settings(Settings::new(Reduction::Full, Integrator::NewmarkExplicit, 0));
@@ -52,7 +35,7 @@ fn horizon(setup: Setup, steps: usize) -> (Option<f64>, f64) {
     let scene = setup.grid.build().unwrap();
     let twins: Vec<Vec<f64>> = (1..=3)
         .map(|seed| {
-            let (_, frames) = run(&setup, steps, Some(&nudge(scene.n_dofs(), scene.dim, 1e-7, seed)));
+            let (_, frames) = run(&setup, steps, Some(&twin_offset(scene.n_dofs(), scene.dim, 1e-7, seed)));
             trajectory_errors_by_window(&frames, &reference, &start, Masses::Equal)
         })
         .collect();

@@ -7,10 +7,8 @@
 //! Past T_p a run is judged by coarse observables, averaged over windows of
 //! [`AVERAGE_S`], against how far the twins' own observables spread.
 
-use modal_mass_spring::measures::{predictability, trajectory_errors_by_window, Masses};
+use modal_mass_spring::measures::{predictability, trajectory_errors_by_window, twin_offset, Masses};
 use modal_mass_spring::physics::*;
-use rand_chacha::rand_core::{RngCore, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 
 use crate::plan::{full_solver, FRAME};
 use crate::run::{run, set_up, simulate};
@@ -106,22 +104,6 @@ pub struct Twins {
     pub wall_s: f64,
 }
 
-/// Every free DOF of one node moved together: each node by a random
-/// direction (uniform in the cube, normalized) times `size` [m].
-fn nudge(dofs: usize, dim: usize, size: f64, seed: u64) -> Vec<f64> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut u = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
-    let mut dy = vec![0.0; dofs];
-    for node in dy.chunks_exact_mut(dim) {
-        let v: Vec<f64> = (0..dim).map(|_| u()).collect();
-        let n = v.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-300);
-        for (d, x) in node.iter_mut().zip(&v) {
-            *d = size * x / n;
-        }
-    }
-    dy
-}
-
 /// The twins of scene `p` over `seconds` (full space, explicit Newmark at
 /// [`TWIN_STEP`], each free node of twin s moved [`TWIN_KICK`] in the
 /// direction [`TWIN_SEEDS`]\[s\] draws) against the same run undisturbed;
@@ -136,7 +118,7 @@ pub fn twins(p: &Grid, seconds: f64, tick: &dyn Fn()) -> Twins {
     let mut spread = [0.0; 4];
     for seed in TWIN_SEEDS {
         let mut prep = set_up(p, &solver).expect("a twin's set-up failed");
-        let dy = nudge(prep.sim.n_dofs(), p.dim, TWIN_KICK, seed);
+        let dy = twin_offset(prep.sim.n_dofs(), p.dim, TWIN_KICK, seed);
         prep.sim.displace(&dy).expect("a twin's start");
         prep.start = prep.sim.snapshot();
         let twin = run(&mut prep, TWIN_STEP, seconds, f64::INFINITY, 1).expect("a twin's run failed");

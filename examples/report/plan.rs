@@ -32,12 +32,14 @@ pub struct Variant {
 pub const PAPER: usize = 0;
 pub const LOAD: usize = 1;
 pub const LOAD_STATIC: usize = 2;
+pub const TRAINED: usize = 7;
+pub const TRAINED_CUBATURE: usize = 8;
 
 /// The paper's method first, then every other option the study compares with it.
 pub fn variants() -> Vec<Variant> {
     use ForceEvaluation::{Cubature, Exact};
     use Linearization::{Equilibrium, Rest};
-    use ModeSelection::{Load, Lowest};
+    use ModeSelection::{Load, Lowest, Trained};
     let v = |key, label, mode_selection, static_correction, linearization, force_evaluation| Variant {
         key,
         label,
@@ -58,6 +60,8 @@ pub fn variants() -> Vec<Variant> {
         v("load+cubature", "load + cubature", Load, false, Rest, Cubature),
         v("load+static+cubature", "load + static correction + cubature", Load, true, Rest, Cubature),
         v("load+static@equilibrium+cubature", "load + static correction @ equilibrium + cubature", Load, true, Equilibrium, Cubature),
+        v("trained", "trained (principal components of the training program)", Trained, false, Rest, Exact),
+        v("trained+cubature", "trained + cubature", Trained, false, Rest, Cubature),
     ]
 }
 
@@ -105,7 +109,7 @@ pub const LARGE_DOFS: usize = 10_000;
 /// 100 x 100) a run with exact forces costs about as much as a full-space
 /// one, and the equilibrium takes a minute to solve there: explicit at steps
 /// 1/240 and 1/60, trigonometric at 1/240, 1/60 and 1/20, with r = 2, 8, 32
-/// (at the equilibrium only r = 32), implicit
+/// (at the equilibrium only r = 32; trained r = 8, 16, 32), implicit
 /// only with cubature (its tangent visits the cubature set only), r = 2 and
 /// 8 at step 1/60.
 pub fn variant_grid(n: usize, v: &Variant) -> Vec<(usize, Integrator, usize)> {
@@ -126,7 +130,9 @@ pub fn variant_grid(n: usize, v: &Variant) -> Vec<(usize, Integrator, usize)> {
     } else {
         let at_equilibrium = v.settings.linearization == Linearization::Equilibrium;
         let cubature = v.settings.force_evaluation == ForceEvaluation::Cubature;
+        let trained = v.settings.mode_selection == ModeSelection::Trained;
         let counts: &[usize] = match (at_equilibrium, cubature) {
+            _ if trained => &[8, 16, 32],
             (false, _) => &[2, 8, 32],
             (true, false) => &[32],
             (true, true) => &[32],
@@ -139,7 +145,7 @@ pub fn variant_grid(n: usize, v: &Variant) -> Vec<(usize, Integrator, usize)> {
                 grid.push((si, Trigonometric, r));
             }
         }
-        if cubature && !at_equilibrium {
+        if cubature && !at_equilibrium && !trained {
             for r in [2, 8] {
                 grid.push((STEP_60, NewmarkImplicit, r));
             }
@@ -221,6 +227,8 @@ pub fn plan_scene(p: &Grid, variants: &[Variant], quick: bool, variants_only: bo
         variant_runs.push((0, Integrator::NewmarkExplicit, 2, LOAD));
         variant_runs.push((2, Integrator::Trigonometric, 16, LOAD_STATIC));
         variant_runs.push((3, Integrator::Trigonometric, 16, LOAD_STATIC));
+        variant_runs.push((1, Integrator::NewmarkExplicit, 32, TRAINED));
+        variant_runs.push((1, Integrator::NewmarkExplicit, 32, TRAINED_CUBATURE));
     } else {
         for (v, variant) in variants.iter().enumerate().skip(1) {
             for (si, integrator, r) in variant_grid(n, variant) {

@@ -4,10 +4,9 @@
 
 use crate::fmi::params::Params;
 use crate::fmi::variables::{index_of, vr, SCENES};
+use crate::measures::twin_offset;
 use crate::options::{FixedNodes, ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction};
 use crate::physics::{Grid, Loads, PhysicsError, Settings, SetupData, Simulator, Training};
-use rand_chacha::rand_core::{RngCore, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 
 impl Params {
     /// The start values of the canonical scene `name` (the `[scenes.NAME]`
@@ -156,23 +155,4 @@ impl Params {
             None => Some(dy),
         }
     }
-}
-
-/// The start of a twin in the free DOFs (`dim` per free node, in their
-/// order): every free node moved by `size` [m] in its own direction, a point
-/// of the cube [-1, 1]^dim drawn from ChaCha8 seeded with `seed` (each
-/// coordinate 53 random bits) and scaled to length `size`: the twins of
-/// `tests/predictability.rs`.
-pub fn twin_offset(dofs: usize, dim: usize, size: f64, seed: u64) -> Vec<f64> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut dy = vec![0.0; dofs];
-    for node in dy.chunks_exact_mut(dim) {
-        for d in node.iter_mut() {
-            *d = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
-        }
-        // A draw of 0 in every coordinate leaves its node where it is.
-        let norm = node.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-300);
-        node.iter_mut().for_each(|d| *d = size * *d / norm);
-    }
-    dy
 }

@@ -74,7 +74,7 @@ pub fn write_readme(out: &str, study: &Study, reference_notes: &str) {
             " (explicit and trigonometric at every step with r = 1, 2, 4, … 32 and implicit at steps 1/60 and 1/20 up to r = 16; on \
              cloth-3d-100x100, where the equilibrium takes about a minute to solve and a run with exact forces costs about as much as \
              a full-space one, explicit at steps 1/240 and 1/60 and trigonometric at 1/240, 1/60 and 1/20 with r = 2, 8, 32 (at the \
-             equilibrium r = 32 only), and implicit with cubature at the rest linearization, r = 2 and 8 \
+             equilibrium r = 32 only; trained r = 8, 16, 32), and implicit with cubature at the rest linearization, r = 2 and 8 \
              at step 1/60)"
         }
     );
