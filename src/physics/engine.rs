@@ -17,7 +17,8 @@ use super::scene::Scene;
 use super::settings::{ForceEvaluation, Integrator, ModeSelection, Reduction, Settings};
 use super::space::{Cubature, Exact, Full, Layout, Modal, Readout};
 use super::state::{Loads, State};
-use super::{snapshots, training};
+use super::snapshots;
+use super::training;
 
 /// The registry: builds the space `settings.reduction` names on `scene`
 /// (with the force model `settings.force_evaluation` names in the modal
