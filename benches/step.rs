@@ -230,6 +230,23 @@ fn cloth_with(n: u64, choices: &[(u32, i64)], correction: bool, limit: f64) -> f
     inst
 }
 
+/// The time of `iters` calls of `fmi3DoStep` of `h` from `time` (advanced),
+/// each followed by a read of the node positions into `positions` when given.
+fn steps(inst: fmi3Instance, iters: u64, h: f64, time: &mut f64, mut positions: Option<&mut Vec<f64>>) -> Duration {
+    let (mut event, mut terminate, mut early, mut last) = (false, false, false, 0.0);
+    let t = Instant::now();
+    for _ in 0..iters {
+        let status = unsafe { fmi3DoStep(inst, *time, h, true, &mut event, &mut terminate, &mut early, &mut last) };
+        assert!(status == fmi3Status_fmi3OK || status == fmi3Status_fmi3Warning);
+        if let Some(x) = positions.as_deref_mut() {
+            let r = vr::POSITIONS;
+            assert_eq!(unsafe { fmi3GetFloat64(inst, &r, 1, x.as_mut_ptr(), x.len()) }, fmi3Status_fmi3OK);
+        }
+        *time += h;
+    }
+    t.elapsed()
+}
+
 fn residual_check(c: &mut Criterion) {
     for n in [30u64, 100] {
         let mut group = c.benchmark_group(format!("residual_check/cloth-3d-{n}x{n}"));
@@ -237,18 +254,7 @@ fn residual_check(c: &mut Criterion) {
         for (label, limit) in [("default forceResidualLimit", 0.9), ("check off", 0.0)] {
             let inst = cloth_instance(n, limit);
             let (h, mut time) = (0.01, 0.0);
-            group.bench_function(label, |b| {
-                b.iter_custom(|iters| {
-                    let (mut event, mut terminate, mut early, mut last) = (false, false, false, 0.0);
-                    let t = Instant::now();
-                    for _ in 0..iters {
-                        let status = unsafe { fmi3DoStep(inst, time, h, true, &mut event, &mut terminate, &mut early, &mut last) };
-                        assert!(status == fmi3Status_fmi3OK || status == fmi3Status_fmi3Warning);
-                        time += h;
-                    }
-                    t.elapsed()
-                })
-            });
+            group.bench_function(label, |b| b.iter_custom(|iters| steps(inst, iters, h, &mut time, None)));
             unsafe { fmi3FreeInstance(inst) };
         }
         group.finish();
@@ -269,22 +275,7 @@ fn trained(c: &mut Criterion) {
             let (h, mut time) = (0.01, 0.0);
             for read in [false, true] {
                 let id = if read { format!("{label}, positions read") } else { label.to_string() };
-                group.bench_function(id, |b| {
-                    b.iter_custom(|iters| {
-                        let (mut event, mut terminate, mut early, mut last) = (false, false, false, 0.0);
-                        let t = Instant::now();
-                        for _ in 0..iters {
-                            let status = unsafe { fmi3DoStep(inst, time, h, true, &mut event, &mut terminate, &mut early, &mut last) };
-                            assert!(status == fmi3Status_fmi3OK || status == fmi3Status_fmi3Warning);
-                            if read {
-                                let r = vr::POSITIONS;
-                                assert_eq!(unsafe { fmi3GetFloat64(inst, &r, 1, positions.as_mut_ptr(), positions.len()) }, fmi3Status_fmi3OK);
-                            }
-                            time += h;
-                        }
-                        t.elapsed()
-                    })
-                });
+                group.bench_function(id, |b| b.iter_custom(|iters| steps(inst, iters, h, &mut time, read.then_some(&mut positions))));
             }
             unsafe { fmi3FreeInstance(inst) };
         }

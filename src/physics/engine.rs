@@ -15,9 +15,9 @@ use super::frame::{Frame, Moments};
 use super::integrator::{Buffers, NewmarkExplicit, NewmarkImplicit, Scheme, Trigonometric};
 use super::scene::Scene;
 use super::settings::{ForceEvaluation, Integrator, ModeSelection, Reduction, Settings};
+use super::snapshots;
 use super::space::{Cubature, Exact, Full, Layout, Modal, Readout};
 use super::state::{Loads, State};
-use super::snapshots;
 use super::training;
 
 /// The registry: builds the space `settings.reduction` names on `scene`
