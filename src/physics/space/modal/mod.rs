@@ -569,7 +569,8 @@ fn check_prebuilt(scene: &Scene, n_modes: usize, data: &SetupData) -> Result<(),
     }
     // Every basis vector is mass-normalized, phi_j^T M phi_j = 1 (each set-up
     // orthonormalizes to round-off, 1e-10); n r operations.
-    if (0..b.r).any(|j| !((0..b.n).map(|k| scene.dof_mass[k] * b.phi[k * b.r + j] * b.phi[k * b.r + j]).sum::<f64>() - 1.0).abs().le(&1e-6)) {
+    let norm_error = |j: usize| ((0..b.n).map(|k| scene.dof_mass[k] * b.phi[k * b.r + j] * b.phi[k * b.r + j]).sum::<f64>() - 1.0).abs();
+    if (0..b.r).map(norm_error).any(|e| e.is_nan() || e > 1e-6) {
         return fail("basis not mass-normalized");
     }
     if data.range.as_ref().is_some_and(|t| t.center.len() != b.r || t.half_width.len() != b.r) {
