@@ -2,7 +2,8 @@
 //! counting global allocator watches fmi3Set of every tunable parameter and
 //! input (to its own value and to another one), fmi3DoStep and fmi3Get of
 //! every scalar output and calculated parameter, for the FMU's default
-//! settings, for cubature forces and for the trigonometric integrator. Only
+//! settings, for cubature forces, for a trained basis with cubature forces
+//! (trainingRange read with the outputs) and for the trigonometric integrator. Only
 //! allocations of the thread that calls count (the test harness's own
 //! threads allocate when they please).
 
@@ -161,6 +162,14 @@ fn default_settings() {
 #[test]
 fn cubature_forces() {
     step_mode_allocates_nothing("cubature", &[(vr::FORCE_EVALUATION, 2)], &[]);
+}
+
+#[test]
+fn trained_basis_with_cubature() {
+    // trainingRange is among the scalar outputs read, trainingRangeLimit among the tunables set.
+    assert!(VARIABLES.iter().any(|v| v.vr == vr::TRAINING_RANGE && scalar_output(v)));
+    assert!(VARIABLES.iter().any(|v| v.vr == vr::TRAINING_RANGE_LIMIT && settable_in_step_mode(v)));
+    step_mode_allocates_nothing("trained, cubature", &[(vr::MODE_SELECTION, 3), (vr::FORCE_EVALUATION, 2)], &[]);
 }
 
 #[test]

@@ -14,6 +14,7 @@ pub mod model;
 use std::ffi::{c_void, CStr, CString};
 use std::ptr::{null, null_mut};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
 
 pub use api::*;
 pub use model::{model, vr, Dim};
@@ -25,9 +26,12 @@ pub const ERROR: fmi3Status = 3;
 pub const FATAL: fmi3Status = 4;
 
 /// Counts of log messages by status (OK .. Fatal); the instanceEnvironment.
+/// With `keep`, also the messages' text.
 #[derive(Default)]
 pub struct Env {
     pub counts: [AtomicUsize; 5],
+    pub keep: bool,
+    pub messages: Mutex<Vec<String>>,
 }
 
 impl Env {
@@ -63,6 +67,9 @@ pub unsafe extern "C" fn logger(env: fmi3InstanceEnvironment, status: fmi3Status
     assert!(!text.is_empty(), "empty log message");
     assert!((0..5).contains(&status), "log status {status}");
     env.counts[status as usize].fetch_add(1, Ordering::Relaxed);
+    if env.keep {
+        env.messages.lock().unwrap().push(String::from_utf8_lossy(text).into_owned());
+    }
     // The message without its numbers names the check that spoke.
     let h = text.iter().filter(|b| !b.is_ascii_digit()).fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3));
     feature(4096 + (h % 4096) as usize);
@@ -74,9 +81,16 @@ pub fn mode(inst: fmi3Instance) -> u8 {
 }
 
 pub fn instantiate(name: &str, env: &Env) -> fmi3Instance {
+    instantiate_with(name, env, None)
+}
+
+/// An instance whose resources are in the folder `resources`.
+pub fn instantiate_with(name: &str, env: &Env, resources: Option<&str>) -> fmi3Instance {
     let name = CString::new(name).unwrap();
     let token = CString::new(model().instantiation_token.as_str()).unwrap();
-    unsafe { fmi().fmi3InstantiateCoSimulation(name.as_ptr(), token.as_ptr(), null(), false, false, false, false, null(), 0, env.ptr(), Some(logger), None) }
+    let path = resources.map(|r| CString::new(r).unwrap());
+    let path = path.as_ref().map_or(null(), |p| p.as_ptr());
+    unsafe { fmi().fmi3InstantiateCoSimulation(name.as_ptr(), token.as_ptr(), path, false, false, false, false, null(), 0, env.ptr(), Some(logger), None) }
 }
 
 /// The whole state of `inst` as bytes (mode, times, parameters, simulator state).

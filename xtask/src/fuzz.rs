@@ -12,6 +12,9 @@
 //!   deeper runs.
 //! - Links the system libFuzzer (Debian's libclang-rt-dev) when present,
 //!   instead of compiling libFuzzer's C++ sources.
+//! - The `bake` target bakes its scenes at start with the crate's `bake`
+//!   example (built here, its path passed as MMS_BAKE_EXAMPLE), so its valid
+//!   bakes come from the same build as the library they are loaded into.
 //! - Inputs that fail are left in `fuzz/artifacts/TARGET/`; the corpus grows
 //!   in `fuzz/corpus/TARGET/` from the seeds in `fuzz/seeds/TARGET/`.
 
@@ -23,7 +26,7 @@ use crate::cli::{self, Long, Value, ValueExt};
 use crate::setup;
 use crate::setup::{cargo, target_dir};
 
-const TARGETS: &[&str] = &["deserialize", "call_sequence"];
+const TARGETS: &[&str] = &["deserialize", "call_sequence", "bake"];
 const DEFAULT_SECONDS: u64 = 30;
 
 pub struct Report {
@@ -38,7 +41,7 @@ usage: cargo xtask fuzz [--seconds N] [--linked] [TARGET...]
   --seconds N  fuzzing time per target (default 30)
   --linked     build the FMU crate into the targets, coverage-instrumented,
                without a sanitizer (minutes to build, deeper runs)
-  TARGET       deserialize, call_sequence (default: every target)";
+  TARGET       deserialize, call_sequence, bake (default: every target)";
 
 struct Options {
     seconds: u64,
@@ -103,6 +106,16 @@ fn system_libfuzzer() -> Option<PathBuf> {
     found.pop()
 }
 
+/// Builds the `bake` example (the writer of resources/setup.bin); its path.
+fn build_bake_example(root: &std::path::Path) -> Result<PathBuf, String> {
+    let status =
+        Command::new(cargo()).current_dir(root).args(["build", "--release", "--example", "bake"]).status().map_err(|e| format!("cannot run cargo: {e}"))?;
+    if !status.success() {
+        return Err("cargo build --release --example bake failed".into());
+    }
+    Ok(target_dir(root).join("release/examples/bake"))
+}
+
 /// Executions and seconds from libFuzzer's "Done 12345 runs in 30 second(s)".
 fn executions(log: &str) -> Option<(u64, f64)> {
     log.lines().rev().find_map(|l| {
@@ -120,6 +133,7 @@ pub fn run(targets: &[String], seconds: u64, linked: bool) -> Result<Vec<Report>
     ensure_cargo_fuzz()?;
     let library = if linked { target_dir(&root).join("release/libmodal_mass_spring.so") } else { crate::fmu::build_library(&root)? };
     let (sanitizer, features): (&str, &[&str]) = if linked { ("none", &["--features", "linked"]) } else { ("address", &[]) };
+    let bake_example = if targets.iter().any(|t| t == "bake") { Some(build_bake_example(&root)?) } else { None };
     let libfuzzer = system_libfuzzer();
     let mut reports = Vec::new();
     for t in targets {
@@ -139,6 +153,9 @@ pub fn run(targets: &[String], seconds: u64, linked: bool) -> Result<Vec<Report>
         }
         // A step is at most 0.1 s of model time; anything near the timeout is a hang.
         cmd.args(["--", &format!("-max_total_time={seconds}"), "-timeout=20", "-max_len=4096", "-print_final_stats=1"]);
+        if let Some(example) = &bake_example {
+            cmd.env("MMS_BAKE_EXAMPLE", example);
+        }
         if let Some(lib) = &libfuzzer {
             cmd.env("CUSTOM_LIBFUZZER_PATH", lib);
         }

@@ -558,6 +558,21 @@ fn check_prebuilt(scene: &Scene, n_modes: usize, data: &SetupData) -> Result<(),
     if !b.phi.iter().chain(&b.lambda).chain(&data.point).all(|x| x.is_finite()) || !(data.omega_sq_bound >= 0.0 && data.omega_sq_bound.is_finite()) {
         return fail("non-finite values");
     }
+    // x* is the rest state, or an equilibrium that moves only free DOFs (the
+    // first n coordinates): a fixed node elsewhere would pull the sheet
+    // from where it hangs. Its springs' energy must be a number.
+    if (data.at_rest && data.point != scene.rest)
+        || data.point[b.n..] != scene.rest[b.n..]
+        || !crate::physics::forces::elastic_energy(scene, &data.point).is_finite()
+    {
+        return fail("linearization point");
+    }
+    // Every basis vector is mass-normalized, phi_j^T M phi_j = 1 (each set-up
+    // orthonormalizes to round-off, 1e-10); n r operations.
+    let norm_error = |j: usize| ((0..b.n).map(|k| scene.dof_mass[k] * b.phi[k * b.r + j] * b.phi[k * b.r + j]).sum::<f64>() - 1.0).abs();
+    if (0..b.r).map(norm_error).any(|e| e.is_nan() || e > 1e-6) {
+        return fail("basis not mass-normalized");
+    }
     if data.range.as_ref().is_some_and(|t| t.center.len() != b.r || t.half_width.len() != b.r) {
         return fail("trained range size");
     }
