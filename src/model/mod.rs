@@ -24,7 +24,7 @@ use crate::fmi::model::{Computed, Model, StepEnd};
 use crate::fmi::serialize::Reader;
 use crate::fmi::variables::{index_of, vr, Causality, VARIABLES};
 use crate::fmi::{OK, WARNING};
-use crate::physics::{Loads, Simulator, Snapshot};
+use crate::physics::{Loads, ModeClasses, Simulator, Snapshot};
 
 pub use crate::fmi::params::Params;
 
@@ -52,6 +52,8 @@ pub struct MassSpring {
     loads: Loads,
     /// The springs between nodes (see [`MassSpring::spring_neighbours`]), made when first read.
     springs: Option<Vec<f64>>,
+    /// modeOutOfPlane and modeSymmetry, made when first read.
+    classes: Option<ModeClasses>,
 }
 
 impl Model for MassSpring {
@@ -70,6 +72,7 @@ impl Model for MassSpring {
             load_column_chosen: false,
             loads: Params::start().loads(),
             springs: None,
+            classes: None,
         }
     }
 
@@ -81,6 +84,7 @@ impl Model for MassSpring {
         self.range_warned = false;
         self.load_column_chosen = false;
         self.springs = None;
+        self.classes = None;
     }
 
     fn is_set_up(&self) -> bool {
@@ -156,6 +160,11 @@ impl Model for MassSpring {
     fn output(&mut self, r: u32, time0: f64) -> Computed<'_> {
         if r == vr::SPRING_NEIGHBOURS {
             return Computed::Array(self.spring_neighbours());
+        }
+        if r == vr::MODE_OUT_OF_PLANE || r == vr::MODE_SYMMETRY {
+            let sim = self.sim.as_ref().expect("outputs are read from a simulator");
+            let classes = self.classes.get_or_insert_with(|| sim.mode_classes());
+            return Computed::Array(if r == vr::MODE_OUT_OF_PLANE { &classes.out_of_plane } else { &classes.symmetry });
         }
         let sim = self.sim.as_mut().expect("outputs are read from a simulator");
         match r {
@@ -312,6 +321,7 @@ impl MassSpring {
         self.sim = Some(sim);
         self.stale = false;
         self.springs = None;
+        self.classes = None;
         self.residual_due = true;
         self.residual_wait = 0;
     }

@@ -13,6 +13,7 @@ use super::bake::SetupData;
 use super::error::{PhysicsError, StepFailure};
 use super::frame::{Frame, Moments};
 use super::integrator::{Buffers, NewmarkExplicit, NewmarkImplicit, Scheme, Trigonometric};
+use super::modes::ModalBasis;
 use super::scene::Scene;
 use super::settings::{ForceEvaluation, Integrator, ModeSelection, Reduction, Settings};
 use super::snapshots;
@@ -73,6 +74,8 @@ pub trait Stepper: Probe + Send {
     fn layout(&self) -> Layout<'_>;
     /// The costly products of the set-up, as data (modal space only).
     fn setup_data(&self) -> Option<SetupData>;
+    /// The kept (modal) or reported (full) modes, if any.
+    fn modes(&self) -> Option<&ModalBasis>;
     /// Longest stable internal step under `loads`, if stability limits it.
     fn stable_step(&self, loads: &Loads) -> Option<f64>;
     /// Squared-frequency bound of the integrated system under `loads` [1/s^2].
@@ -246,6 +249,10 @@ impl<S: Readout, I: Scheme> Stepper for Engine<S, I> {
 
     fn setup_data(&self) -> Option<SetupData> {
         self.space.setup_data()
+    }
+
+    fn modes(&self) -> Option<&ModalBasis> {
+        self.space.modes()
     }
 
     fn stable_step(&self, loads: &Loads) -> Option<f64> {

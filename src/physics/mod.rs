@@ -5,6 +5,7 @@
 //!   builds the canonical scenes, nothing else knows there is a grid;
 //! - [`forces`]: exact spring forces, tangent stiffness, sparsity;
 //! - [`modes`]: the generalized eigen decomposition K phi = lambda M phi;
+//! - [`mode_classes`]: what each mode looks like (out of plane, mirror symmetry);
 //! - [`basis`]: where to linearize ([`equilibrium`]), which modes to keep, the static correction;
 //! - [`space`]: where the equations M y'' + C y' = h(y) live (modal, full),
 //!   each a constant model with its own scratch;
@@ -31,6 +32,7 @@ pub mod forces;
 pub mod frame;
 pub mod grid;
 pub mod integrator;
+pub mod mode_classes;
 pub mod modes;
 pub mod scene;
 pub mod settings;
@@ -44,6 +46,7 @@ pub use bake::{SetupData, SpringSet, TrainedRange};
 pub use error::{PhysicsError, Quantity, StepFailure};
 pub use grid::{FixedNodes, Grid};
 pub use integrator::EXPLICIT_SAFETY;
+pub use mode_classes::ModeClasses;
 pub use scene::Scene;
 pub use settings::{ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction, Settings, Training};
 pub use simulator::{internal_step_count, Simulator, MAX_INTERNAL_STEPS_PER_CALL, STEP_COUNT_TOLERANCE};

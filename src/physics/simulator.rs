@@ -15,6 +15,8 @@ use super::bake::SetupData;
 use super::engine::{self, Outputs, Stepper};
 use super::error::{positive, Expected, PhysicsError, Quantity, StepFailure};
 use super::frame::{self, apply, apply_transposed, compose, cross, dot, norm, rotation, Frame};
+use super::mode_classes::{self, ModeClasses};
+use super::modes::ModalBasis;
 use super::scene::Scene;
 use super::settings::{Reduction, Settings};
 use super::state::{Loads, Snapshot, State};
@@ -485,6 +487,14 @@ impl Simulator {
     /// omega_i of the kept or reported modes, ascending [rad/s].
     pub fn mode_frequencies(&self) -> &[f64] {
         self.engine.layout().frequencies
+    }
+    /// The kept (modal) or reported (full) modes: shapes Phi (row-major n x r over the free DOFs), lambda_i.
+    pub fn mode_shapes(&self) -> Option<&ModalBasis> {
+        self.engine.modes()
+    }
+    /// Out-of-plane share and mirror symmetry of each mode of [`Self::mode_shapes`] (empty without). O(n r).
+    pub fn mode_classes(&self) -> ModeClasses {
+        self.engine.modes().map_or_else(ModeClasses::default, |b| mode_classes::classify(self.engine.scene(), b))
     }
     /// The spring force at generalized coordinates `y` as the space
     /// evaluates it: Phi^T f(x* + Phi y) in the modal space (every spring,

@@ -77,6 +77,8 @@ INTERFACE = {
     "springNeighbours": ("UInt64", "calculatedParameter", "fixed"),
     "startOffset": ("Float64", "parameter", "fixed"),
     "startSeed": ("UInt64", "parameter", "fixed"),
+    "modeOutOfPlane": ("Float64", "calculatedParameter", "fixed"),
+    "modeSymmetry": ("Float64", "calculatedParameter", "fixed"),
 }
 
 ENUMERATIONS = {
@@ -96,6 +98,8 @@ DIMENSIONS = {
     "modalCoordinates": ["nModes"],
     "modeFrequencies": ["nModes"],
     "springNeighbours": ["ny", "nx", 6],
+    "modeOutOfPlane": ["nModes"],
+    "modeSymmetry": ["nModes"],
 }
 
 

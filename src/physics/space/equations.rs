@@ -5,6 +5,7 @@
 use crate::physics::bake::{SetupData, TrainedRange};
 use crate::physics::error::StepFailure;
 use crate::physics::frame::{Frame, Moments};
+use crate::physics::modes::ModalBasis;
 use crate::physics::scene::Scene;
 use crate::physics::state::Loads;
 
@@ -54,6 +55,10 @@ pub trait Space: Send + Sized + 'static {
     fn layout(&self) -> Layout<'_>;
     /// The costly products of the set-up, as data (modal space only).
     fn setup_data(&self) -> Option<SetupData> {
+        None
+    }
+    /// The kept (modal) or reported (full) modes, if any.
+    fn modes(&self) -> Option<&ModalBasis> {
         None
     }
     /// Fresh load terms (all zero) and scratch.

@@ -277,6 +277,10 @@ impl Space for Full {
         }
     }
 
+    fn modes(&self) -> Option<&ModalBasis> {
+        self.reported.as_ref()
+    }
+
     fn work(&self) -> FullWork {
         let n = self.scene.n_dofs();
         let req = StackReq::any_of(&[

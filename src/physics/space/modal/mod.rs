@@ -181,6 +181,10 @@ impl<F: ReducedForce> Space for Modal<F> {
         })
     }
 
+    fn modes(&self) -> Option<&ModalBasis> {
+        Some(&self.modes.basis)
+    }
+
     fn work(&self) -> ModalWork<F::Work> {
         let r = self.modes.basis.r;
         let req =

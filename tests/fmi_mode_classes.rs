@@ -1,0 +1,122 @@
+//! modeOutOfPlane and modeSymmetry, read through the C functions on the
+//! canonical scenes, say which mode is which: in 3D the lowest modes are the
+//! auxiliary springs' out-of-plane cluster and the modes gravity loads lie
+//! in the plane; in 2D nothing leaves the plane and, the canonical grids
+//! being mirror-symmetric, every mode is symmetric or antisymmetric.
+
+mod common;
+
+use common::*;
+use modal_mass_spring::fmi::exports::*;
+use modal_mass_spring::fmi::variables::{index_of, vr, Type, SCENES, VARIABLES};
+use modal_mass_spring::options::ModeSelection;
+
+/// How far from 0 or +-1 a class may read where the structure makes it
+/// exact. At rest the flat sheet's stiffness does not couple the
+/// out-of-plane DOFs to the in-plane ones, and mirror-symmetric stiffness
+/// and masses do not couple symmetric to antisymmetric shapes: the
+/// eigensolver mixes two modes only by round-off, with an amplitude a of
+/// about eps * lambda_max / gap, which is below 2.2e-8 where neighbouring
+/// eigenvalues are at least 1e-8 lambda_max apart (checked by [`simple`];
+/// the closest pair on these scenes is 3e-7 lambda_max apart). A mix enters
+/// both classes squared (1 - |s| = 2 a^2 < 1e-15), and the sums over 200
+/// DOFs add some 200 eps = 4e-14: 1e-12 holds both (measured: 1.4e-15).
+/// A mode that is really mixed reads 1e-2 or more off.
+const EXACT: f64 = 1e-12;
+
+/// An instance set to the canonical scene `name`, through the setters.
+fn scene(name: &str) -> Fmu {
+    let f = Fmu::new();
+    let s = SCENES.iter().find(|s| s.name == name).unwrap();
+    for &(r, values) in s.values {
+        let v = values[0];
+        let status = match VARIABLES[index_of(r).unwrap()].ty {
+            Type::Float64 => f.set_f64(r, &[v]),
+            Type::UInt64 => f.set_u64(r, v as u64),
+            Type::Int64 => f.set_i64(r, v as i64),
+            Type::Boolean => unsafe { fmi3SetBoolean(f.inst, &r, 1, &(v != 0.0), 1) },
+        };
+        assert_eq!(status, OK, "{name}: {:?}", f.messages());
+    }
+    f
+}
+
+/// (frequencies, modeOutOfPlane, modeSymmetry) of `f`.
+fn classes(f: &Fmu) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let r = f.sizes().3;
+    (f.f64s(vr::MODE_FREQUENCIES, r), f.f64s(vr::MODE_OUT_OF_PLANE, r), f.f64s(vr::MODE_SYMMETRY, r))
+}
+
+/// Neighbouring eigenvalues lambda = omega^2 (outside `cluster`) are
+/// apart by at least 1e-8 of the largest, so round-off mixes no two modes
+/// by more than [`EXACT`] allows.
+fn simple(omega: &[f64], cluster: impl Fn(f64) -> bool) {
+    let top = omega.iter().fold(0.0f64, |m, &w| m.max(w * w));
+    let lambdas: Vec<f64> = omega.iter().filter(|&&w| !cluster(w)).map(|w| w * w).collect();
+    for p in lambdas.windows(2) {
+        assert!(p[1] - p[0] > 1e-8 * top, "a repeated frequency: {p:?}");
+    }
+}
+
+#[test]
+fn three_d_cluster_is_out_of_plane_and_load_modes_in_it() {
+    let f = scene("paper-3d-sheet");
+    let (omega, out, sym) = classes(&f);
+    assert_eq!(omega.len(), 126);
+    // One mode per free node at sqrt(auxStiffness / nodeMass), the lowest.
+    let aux = (0.05f64 / 0.01).sqrt();
+    let in_cluster = |w: f64| (w - aux).abs() < 1e-9 * aux;
+    let cluster: Vec<usize> = (0..omega.len()).filter(|&i| in_cluster(omega[i])).collect();
+    assert_eq!(cluster, (0..42).collect::<Vec<_>>(), "{omega:?}");
+    simple(&omega, in_cluster);
+    for i in 0..omega.len() {
+        if in_cluster(omega[i]) {
+            assert!(out[i] > 1.0 - EXACT, "mode {i}: {}", out[i]);
+            // A repeated frequency: any mix of its eigenspace, but a correlation all the same.
+            assert!(sym[i].abs() <= 1.0 + 1e-12, "mode {i}: {}", sym[i]);
+        } else {
+            assert!(out[i] < EXACT, "mode {i}: {}", out[i]);
+            assert!(1.0 - sym[i].abs() < EXACT, "mode {i}: {}", sym[i]);
+        }
+    }
+    // Both kinds are there in the plane.
+    assert!(sym[42..].iter().any(|&s| s > 0.0) && sym[42..].iter().any(|&s| s < 0.0));
+    // Readable in Step Mode too, the same.
+    f.init();
+    assert_eq!(bits(&classes(&f).1), bits(&out));
+
+    // The modes gravity (along -y, on the mid-line) loads: in the plane and symmetric.
+    let f = scene("paper-3d-sheet");
+    assert_eq!(f.set_u64(vr::N_MODES, 6), OK);
+    assert_eq!(f.set_i64(vr::MODE_SELECTION, ModeSelection::Load as i64), OK);
+    let (omega, out, sym) = classes(&f);
+    assert!(omega.iter().all(|&w| w > 1.5 * aux), "{omega:?}");
+    for i in 0..6 {
+        assert!(out[i] < EXACT && sym[i] > 1.0 - EXACT, "load mode {i}: {} {}", out[i], sym[i]);
+    }
+}
+
+#[test]
+fn two_d_modes_are_in_plane_and_symmetric_or_antisymmetric() {
+    for name in ["paper-2d-top-row", "paper-2d-top-corners"] {
+        for reduction in [1u64, 2] {
+            let f = scene(name);
+            // Every mode of the scene: the modal basis keeps them, full space reports them.
+            let (nx, ny, _, _) = f.sizes();
+            let held = if name.ends_with("row") { nx } else { 2 };
+            let dofs = 2 * (nx * ny - held);
+            assert_eq!(f.set_u64(vr::N_MODES, dofs as u64), OK);
+            assert_eq!(f.set_i64(vr::REDUCTION, reduction as i64), OK);
+            let (omega, out, sym) = classes(&f);
+            assert_eq!(omega.len(), dofs);
+            simple(&omega, |_| false);
+            let what = format!("{name}, reduction {reduction}");
+            assert!(out.iter().all(|&o| o == 0.0), "{what}: {out:?}");
+            for (i, s) in sym.iter().enumerate() {
+                assert!(1.0 - s.abs() < EXACT, "{what}, mode {i}: {s}");
+            }
+            let plus = sym.iter().filter(|&&s| s > 0.0).count();
+            assert!(plus > dofs / 3 && plus < 2 * dofs / 3, "{what}: {plus} of {dofs} symmetric");
+        }
+    }
+}
