@@ -42,6 +42,27 @@ pub struct ModeClasses {
     pub symmetry: Vec<f64>,
 }
 
+/// A symmetry at least this far from 0 names a mode symmetric or antisymmetric; closer, mixed.
+pub const SYMMETRY_CLASS: f64 = 0.9;
+
+impl ModeClasses {
+    /// A name for mode `i`: "out-of-plane" where more than half of its
+    /// mass-weighted amplitude leaves the plane, "in-plane" otherwise; then
+    /// "symmetric", "antisymmetric" or "mixed" by [`SYMMETRY_CLASS`].
+    pub fn label(&self, i: usize) -> String {
+        let plane = if self.out_of_plane[i] > 0.5 { "out-of-plane" } else { "in-plane" };
+        let s = self.symmetry[i];
+        let mirror = if s >= SYMMETRY_CLASS {
+            "symmetric"
+        } else if s <= -SYMMETRY_CLASS {
+            "antisymmetric"
+        } else {
+            "mixed"
+        };
+        format!("{plane} {mirror}")
+    }
+}
+
 /// The classes of the `basis.r` modes of `basis` (shapes over the free DOFs of `scene`).
 pub fn classify(scene: &Scene, basis: &ModalBasis) -> ModeClasses {
     let (d, r) = (scene.dim, basis.r);
