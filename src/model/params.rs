@@ -120,39 +120,20 @@ impl Params {
     }
 
     /// Set-up with the costly part taken from a baked `prebuilt` when given;
-    /// a twin (startOffset > 0) starts displaced ([`Params::twin_start`]).
+    /// a twin (startOffset > 0) starts with every free node moved by
+    /// startOffset in the direction [`twin_offset`] draws from startSeed
+    /// (`docs/method.md`, section 6; [`Simulator::displace_dofs`]).
     pub fn build_with(&self, prebuilt: Option<&SetupData>) -> Result<Simulator, PhysicsError> {
         let scene = self.grid().build()?;
         if self.load_node_problem().is_some() {
             return Err(PhysicsError::LoadNode { node: self.load_node(), held: self.load_node().is_some() });
         }
+        let (dofs, dim) = (scene.n_dofs(), scene.dim);
         let mut sim = Simulator::with_setup(scene, &self.settings(), &self.loads(), prebuilt)?;
-        if let Some(dy) = self.twin_start(&sim) {
-            sim.displace(&dy)?;
+        let size = self.scalar(vr::START_OFFSET);
+        if size != 0.0 {
+            sim.displace_dofs(&twin_offset(dofs, dim, size, self.scalar(vr::START_SEED) as u64))?;
         }
         Ok(sim)
-    }
-
-    /// The displacement of the generalized coordinates that starts a twin
-    /// (`docs/method.md`, section 6), `None` for the canonical start
-    /// (startOffset = 0): every free node moved by startOffset in the
-    /// direction [`twin_offset`] draws from startSeed; in the modal space the
-    /// modal coordinates of that displacement, q = Phi^T M dy (the part the
-    /// basis holds).
-    pub fn twin_start(&self, sim: &Simulator) -> Option<Vec<f64>> {
-        let size = self.scalar(vr::START_OFFSET);
-        if size == 0.0 {
-            return None;
-        }
-        let scene = sim.scene();
-        let dy = twin_offset(scene.n_dofs(), scene.dim, size, self.scalar(vr::START_SEED) as u64);
-        match sim.setup_data() {
-            Some(modal) => {
-                let mut q = vec![0.0; modal.basis.r];
-                modal.basis.project_displacement(&scene.dof_mass, &dy, &mut q);
-                Some(q)
-            }
-            None => Some(dy),
-        }
     }
 }

@@ -623,6 +623,24 @@ impl Simulator {
         Ok(())
     }
 
+    /// [`Self::displace`] by a displacement `dy` of the free DOFs: in the
+    /// modal space by its modal coordinates q = Phi^T M dy (the part the
+    /// basis holds).
+    pub fn displace_dofs(&mut self, dy: &[f64]) -> Result<(), PhysicsError> {
+        if dy.len() != self.n_dofs() {
+            return Err(PhysicsError::SnapshotLength { len: dy.len(), expected: self.n_dofs() });
+        }
+        let q = match (self.engine.layout().kept_modes, self.engine.modes()) {
+            (Some(r), Some(basis)) => {
+                let mut q = vec![0.0; r];
+                basis.project_displacement(&self.engine.scene().dof_mass, dy, &mut q);
+                q
+            }
+            _ => dy.to_vec(),
+        };
+        self.displace(&q)
+    }
+
     /// The state and the loads: all a run needs to resume.
     pub fn snapshot(&self) -> Snapshot {
         Snapshot { state: self.state.clone(), loads: self.loads.clone() }
