@@ -302,6 +302,7 @@ fn size(f: &Fmu, r: u32) -> usize {
         vr::POSITIONS | vr::VELOCITIES => nx * ny * d,
         vr::MODAL_COORDINATES | vr::MODE_FREQUENCIES | vr::MODE_WEIGHTS | vr::MODE_OUT_OF_PLANE | vr::MODE_SYMMETRY => modes,
         vr::GRAVITY => 3,
+        vr::MODE_SHAPES => modes * nx * ny * d,
         vr::SPRING_NEIGHBOURS => nx * ny * 6,
         _ => 1,
     }

@@ -24,7 +24,7 @@ use crate::fmi::model::{Computed, Model, StepEnd};
 use crate::fmi::serialize::Reader;
 use crate::fmi::variables::{index_of, vr, Causality, VARIABLES};
 use crate::fmi::{OK, WARNING};
-use crate::physics::{Loads, ModeClasses, Simulator, Snapshot};
+use crate::physics::{mode_classes, Loads, ModeClasses, Simulator, Snapshot};
 
 pub use crate::fmi::params::Params;
 
@@ -54,6 +54,8 @@ pub struct MassSpring {
     springs: Option<Vec<f64>>,
     /// modeOutOfPlane and modeSymmetry, made when first read.
     classes: Option<ModeClasses>,
+    /// modeShapes, made when first read.
+    shapes: Option<Vec<f64>>,
 }
 
 impl Model for MassSpring {
@@ -73,6 +75,7 @@ impl Model for MassSpring {
             loads: Params::start().loads(),
             springs: None,
             classes: None,
+            shapes: None,
         }
     }
 
@@ -85,6 +88,7 @@ impl Model for MassSpring {
         self.load_column_chosen = false;
         self.springs = None;
         self.classes = None;
+        self.shapes = None;
     }
 
     fn is_set_up(&self) -> bool {
@@ -165,6 +169,11 @@ impl Model for MassSpring {
             let sim = self.sim.as_ref().expect("outputs are read from a simulator");
             let classes = self.classes.get_or_insert_with(|| sim.mode_classes());
             return Computed::Array(if r == vr::MODE_OUT_OF_PLANE { &classes.out_of_plane } else { &classes.symmetry });
+        }
+        if r == vr::MODE_SHAPES {
+            let sim = self.sim.as_ref().expect("outputs are read from a simulator");
+            let shapes = self.shapes.get_or_insert_with(|| sim.mode_shapes().map_or_else(Vec::new, |b| mode_classes::grid_shapes(sim.scene(), b)));
+            return Computed::Array(shapes);
         }
         let sim = self.sim.as_mut().expect("outputs are read from a simulator");
         match r {
@@ -322,6 +331,7 @@ impl MassSpring {
         self.stale = false;
         self.springs = None;
         self.classes = None;
+        self.shapes = None;
         self.residual_due = true;
         self.residual_wait = 0;
     }

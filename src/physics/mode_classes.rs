@@ -91,6 +91,26 @@ pub fn classify(scene: &Scene, basis: &ModalBasis) -> ModeClasses {
     out
 }
 
+/// Every mode of `basis` laid out on the grid as the node outputs are:
+/// `[r][n_nodes][dim]`, mode after mode, nodes in the scene's order (row by row), the
+/// shape phi_k of each free node and 0 on a held one. The modes are
+/// mass-normalized (sum_k m_k |phi_k|^2 = 1), so a drawing scales them.
+/// O(n r) once.
+pub fn grid_shapes(scene: &Scene, basis: &ModalBasis) -> Vec<f64> {
+    let (d, r, n) = (scene.dim, basis.r, scene.n_nodes);
+    let mut out = vec![0.0; r * n * d];
+    for i in 0..r {
+        for (node, &slot) in scene.slot_of_node.iter().enumerate() {
+            if slot < scene.n_free {
+                for a in 0..d {
+                    out[(i * n + node) * d + a] = basis.phi[(slot * d + a) * r + i];
+                }
+            }
+        }
+    }
+    out
+}
+
 /// For each free node, the free node resting at its mirror image about the
 /// nodes' mid-line x = (x_min + x_max) / 2, if there is one.
 fn mirror_nodes(scene: &Scene) -> Vec<Option<usize>> {

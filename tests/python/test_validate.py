@@ -79,6 +79,7 @@ INTERFACE = {
     "startSeed": ("UInt64", "parameter", "fixed"),
     "modeOutOfPlane": ("Float64", "calculatedParameter", "fixed"),
     "modeSymmetry": ("Float64", "calculatedParameter", "fixed"),
+    "modeShapes": ("Float64", "calculatedParameter", "fixed"),
 }
 
 ENUMERATIONS = {
@@ -100,6 +101,7 @@ DIMENSIONS = {
     "springNeighbours": ["ny", "nx", 6],
     "modeOutOfPlane": ["nModes"],
     "modeSymmetry": ["nModes"],
+    "modeShapes": ["nModes", "ny", "nx", "dimension"],
 }
 
 
