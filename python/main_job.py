@@ -14,6 +14,8 @@ import time
 import numpy as np
 from fmpy import read_model_description, simulate_fmu
 
+from sheet import fixed_nodes, springs
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OUTPUTS = ["positions", "modalCoordinates", "kineticEnergy", "potentialEnergy", "modeFrequencies", "springNeighbours"]
 
@@ -38,23 +40,6 @@ def start_values(md):
     return out, items
 
 
-def springs(neighbours, n):
-    """Node pairs (i, j) of the springs of a sheet of n nodes, node index
-    i = row * nx + col, from the FMU's springNeighbours: per node the nodes
-    j > i it is joined to, then n (no node) in the places left."""
-    j = np.asarray(neighbours, dtype=np.int64).reshape(n, -1)
-    i = np.repeat(np.arange(n), j.shape[1])
-    j = j.ravel()
-    keep = j < n
-    return np.stack([i[keep], j[keep]], axis=1)
-
-
-def fixed_nodes(nx, ny, kind):
-    if kind == "top-row":
-        return list(range(nx))
-    return sorted({0, nx - 1})
-
-
 def plot(path, res, sv, items, title, n_frames=5):
     import matplotlib
 
@@ -66,7 +51,7 @@ def plot(path, res, sv, items, title, n_frames=5):
     t = res["time"]
     x = res["positions"].reshape(len(t), nx * ny, -1)
     pairs = springs(res["springNeighbours"][0], nx * ny)
-    fixed = fixed_nodes(nx, ny, items["fixedNodes"])
+    fixed = fixed_nodes(nx, items["fixedNodes"])
     frames = [int(round(k)) for k in np.linspace(0, len(t) - 1, n_frames)]
 
     fig = plt.figure(figsize=(3.2 * n_frames, 7.2))

@@ -18,6 +18,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 
+from pictures import compact  # noqa: E402
+
 
 def read(out):
     modes = list(csv.DictReader(open(os.path.join(out, "modes.csv"))))
@@ -66,6 +68,7 @@ def gallery(out, modes, shapes, springs, name, dim):
     fig.tight_layout()
     fig.savefig(os.path.join(out, "modes.png"), dpi=90)
     plt.close(fig)
+    compact(os.path.join(out, "modes.png"))
 
 
 def table(out, modes, name):

@@ -27,7 +27,7 @@ use cli::{Value, ValueExt};
 
 /// Every task: its name, its entry point and what it does (`cargo xtask --help`).
 type Task = fn(&[String]) -> Result<(), String>;
-const TASKS: [(&str, Task, &str); 12] = [
+const TASKS: [(&str, Task, &str); 13] = [
     ("fmu", fmu::main, "build the release library and package target/fmu/ModalMassSpring.fmu"),
     ("run", run::run, "build the FMU and run the main job through fmpy (summary + plot)"),
     ("test", run::test, "every test: Rust (cargo test) and Python (pytest + fmpy); --only STAGE,... for some"),
@@ -38,6 +38,7 @@ const TASKS: [(&str, Task, &str); 12] = [
     ("fuzz", fuzz::main, "the cargo-fuzz targets for a bounded time (--seconds N)"),
     ("valgrind", valgrind::main, "leak check of instantiate/step/serialize/free cycles"),
     ("stability", stability::main, "the stability matrix, its table written into docs/stability.md"),
+    ("control", run::control, "the paper's control experiments (Figs. 7-9, a GIF) and control in 3D, through the FMU, into target/control"),
     ("modes", modes::main, "the mode gallery of a scene: shapes, frequencies and classes into target/modes (PNG, Markdown)"),
     ("docs", docs::main, "the variable tables of docs/variables.md, from modelDescription/variables.toml"),
 ];

@@ -1,8 +1,10 @@
-//! `cargo xtask run` and `cargo xtask test`.
+//! `cargo xtask run`, `cargo xtask control` and `cargo xtask test`.
 //!
 //! - `run [--out PNG] [--stop-time S]`: setup, build `target/fmu/ModalMassSpring.fmu`,
 //!   then the main job `python/main_job.py` (fmpy simulates the default scene,
 //!   prints a summary and writes `out/default_scene.png`).
+//! - `control [--figure NAMES] [--out DIR]`: the same, then `python/control.py`
+//!   (the paper's control experiments and control in 3D through the FMU).
 //! - `test [--only STAGE[,STAGE...]] [PYTEST ARGS...]`: setup, build the
 //!   default FMU and one scene-baked FMU per canonical scene into
 //!   `target/fmu/`, `cargo fmt --check`, each fuzz target for FUZZ_SECONDS,
@@ -57,8 +59,26 @@ python/main_job.py on it with every argument (`cargo xtask run -- --help`
 shows them all), e.g. --stop-time S, --out PNG.";
 
 pub fn run(args: &[String]) -> Result<(), String> {
-    let Some(args) = cli::options(cli::pass_through(args), RUN_USAGE)? else {
-        setup::python_help("python/main_job.py");
+    fmu_job(args, RUN_USAGE, "python/main_job.py", "main job")
+}
+
+const CONTROL_USAGE: &str = "\
+usage: cargo xtask control [--] [--figure fig7,fig8,fig9,3d | all] [--out DIR]
+
+Installs what it needs, builds target/fmu/ModalMassSpring.fmu and runs
+python/control.py on it: the paper's Figs. 7, 8 (with its GIF) and 9 and the
+control of the 3D sheet by mode class, through the FMU, as pictures and
+numbers.txt in DIR (default target/control; docs/control/ holds the
+committed ones: --out docs/control). docs/control.md explains them.";
+
+pub fn control(args: &[String]) -> Result<(), String> {
+    fmu_job(args, CONTROL_USAGE, "python/control.py", "control figures")
+}
+
+/// Setup, the default FMU, then `script FMU ARGS...` in the venv's Python.
+fn fmu_job(args: &[String], usage: &str, script: &str, what: &str) -> Result<(), String> {
+    let Some(args) = cli::options(cli::pass_through(args), usage)? else {
+        setup::python_help(script);
         return Ok(());
     };
     let root = setup::root();
@@ -67,16 +87,16 @@ pub fn run(args: &[String]) -> Result<(), String> {
     step("cargo xtask fmu");
     fmu::main(&[])?;
     let fmu = fmu_dir(&root).join("ModalMassSpring.fmu");
-    step("main job: python/main_job.py");
+    step(&format!("{what}: {script}"));
     let status = Command::new(setup::python())
         .current_dir(&root)
-        .arg("python/main_job.py")
+        .arg(script)
         .arg(&fmu)
         .args(&args)
         .status()
         .map_err(|e| format!("cannot run the venv's python: {e}"))?;
     if !status.success() {
-        return Err(format!("the main job failed ({status})"));
+        return Err(format!("the {what} failed ({status})"));
     }
     Ok(())
 }
