@@ -1,0 +1,57 @@
+"""The examples in python/examples/ run as a user runs them (a subprocess
+on the default FMU) and show what their docstrings say."""
+
+import re
+import subprocess
+import sys
+
+import pytest
+
+from conftest import ROOT
+
+EXAMPLES = ROOT / "python" / "examples"
+
+
+def run(script, *args):
+    r = subprocess.run([sys.executable, str(EXAMPLES / script), *args], capture_output=True, text=True, cwd=ROOT)
+    assert r.returncode == 0, r.stdout + r.stderr
+    return r.stdout
+
+
+def displacements(text):
+    """(x, y, z) of the line 'largest displacement of a node ...'."""
+    m = re.search(r"x (\S+) m, y (\S+) m, z (\S+) m", text)
+    return [float(v) for v in m.groups()]
+
+
+@pytest.mark.parametrize("keep,count", [("in-plane", 84), ("out-of-plane", 42), ("symmetric", 42), ("antisymmetric", 42), ("all", 126)])
+def test_choose_by_class(default_fmu, keep, count):
+    out = run("choose_by_class.py", default_fmu, "--keep", keep, "--seconds", "0.5")
+    assert f"kept {count} of 126 modes ({keep})" in out
+    x, y, z = displacements(out)
+    if keep == "in-plane":
+        assert z < 1e-13 and max(x, y) > 1e-2
+    elif keep == "out-of-plane":
+        assert z > 1e-2 and max(x, y) < 1e-13
+    else:
+        assert max(x, y) > 1e-3
+
+
+def test_weights_mid_run(default_fmu):
+    out = run("weights_mid_run.py", default_fmu, "--at", "0.5", "--seconds", "1")
+    m = re.search(r"bottom rows: (\S+) m up to t = 0.50 s, (\S+) m after", out)
+    before, after = float(m.group(1)), float(m.group(2))
+    assert before == 0.0 and after > 1e-2, out
+
+
+def test_mode_gallery(default_fmu, tmp_path):
+    png = tmp_path / "gallery.png"
+    out = run("mode_gallery.py", default_fmu, "--out", str(png))
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    lines = [l for l in out.splitlines() if l.startswith("mode ")]
+    assert len(lines) == 6
+    # Gravity down and sideways in the plane loads in-plane modes of both parities.
+    assert all("out of plane 0.000" in l for l in lines)
+    assert any("symmetry +1.000" in l for l in lines) and any("symmetry -1.000" in l for l in lines)
+    out = run("mode_gallery.py", default_fmu, "--dimension", "2", "--modes", "4", "--mode-selection", "lowest", "--out", str(png))
+    assert len([l for l in out.splitlines() if l.startswith("mode ")]) == 4
