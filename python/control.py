@@ -297,21 +297,30 @@ def animation(path, panels, title, fps=12.5, three_d=False, colours=COLOURS):
 # ---- the figures: runs, pictures, numbers -----------------------------------------
 
 
-def fig7(fmu, out):
-    runs = fig7_runs(fmu)
+INSTANTS = [0.1, 0.2, 0.3, 0.5, 1.0, 2.0]
+
+
+def against_full(runs, out, name, scene_name, three_d=False):
+    """Full space against the modal run of `runs`: the picture NAME.png and
+    the line of numbers (E over the run, the largest node distance)."""
     full, modal = runs["full"], runs["modal"]
     e, d = error(modal, full), largest_node_error(modal, full)
     sheets(
-        os.path.join(out, "fig7.png"),
-        [("full space", full, 1.0), ("2 lowest modes", modal, 1.0)],
-        [0.1, 0.2, 0.3, 0.5, 1.0, 2.0],
-        f"Fig. 7: paper-2d-top-row, full space against the 2 lowest modes (E = {e:.3f} over 2 s)",
-        trace=bottom_row_trace([full, modal]),
+        os.path.join(out, f"{name}.png"),
+        [("full space", full, 1.0), (modal.label, modal, 1.0)],
+        INSTANTS,
+        f"Fig. {name[3:]}: {scene_name}, full space against {modal.label} (E = {e:.2g} over {STOP:g} s, largest node distance {d:.2g} m)",
+        trace=None if three_d else bottom_row_trace([full, modal]),
+        three_d=three_d,
     )
     return [
-        f"fig7: 2 lowest modes against full space over {STOP:g} s: E = {e:.4f}, largest node distance {d * 1000:.1f} mm, "
-        f"largest displacement {largest_displacement(full):.3f} m (full) / {largest_displacement(modal):.3f} m (modal)"
+        f"{name}: {modal.label} against full space over {STOP:g} s: E = {e:.3g}, largest node distance {d:.3g} m, "
+        f"largest displacement {largest_displacement(full):.3g} m (full) / {largest_displacement(modal):.3g} m (modal)"
     ]
+
+
+def fig7(fmu, out):
+    return against_full(fig7_runs(fmu), out, "fig7", "paper-2d-top-row")
 
 
 def fig8(fmu, out):
@@ -320,7 +329,7 @@ def fig8(fmu, out):
     sheets(
         os.path.join(out, "fig8.png"),
         sets + [("full space (for comparison)", runs["full"], 1.0)],
-        [0.1, 0.2, 0.3, 0.5, 1.0, 2.0],
+        INSTANTS,
         f"Fig. 8: paper-2d-top-corners, nodes {HEAVIER:g}x as heavy, three sets of modes",
     )
     animation(os.path.join(out, "fig8.gif"), sets, "paper-2d-top-corners, three sets of modes")
@@ -337,17 +346,7 @@ def fig8(fmu, out):
 
 
 def fig9(fmu, out):
-    runs = fig9_runs(fmu)
-    full, modal = runs["full"], runs["modal"]
-    e, d = error(modal, full), largest_node_error(modal, full)
-    sheets(
-        os.path.join(out, "fig9.png"),
-        [("full space", full, 1.0), (modal.label, modal, 1.0)],
-        [0.1, 0.2, 0.3, 0.5, 1.0, 2.0],
-        f"Fig. 9: paper-3d-sheet, full space against {modal.label} (E = {e:.1e}, largest node distance {d:.1e} m)",
-        three_d=True,
-    )
-    return [f"fig9: {modal.label} against full space over {STOP:g} s: E = {e:.2e}, largest node distance {d:.2e} m"]
+    return against_full(fig9_runs(fmu), out, "fig9", "paper-3d-sheet", three_d=True)
 
 
 def largest_out_of_plane(run):
