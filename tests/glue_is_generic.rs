@@ -22,20 +22,33 @@ fn variable_names() -> Vec<String> {
     names
 }
 
+/// Every Rust file under `dir`, recursively (directory modules such as `exports/` too).
+fn rust_files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for p in std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()) {
+        if p.is_dir() {
+            out.extend(rust_files(&p));
+        } else if p.extension().is_some_and(|e| e == "rs") {
+            out.push(p);
+        }
+    }
+    out
+}
+
 /// The glue's sources, but the generated table.
 fn glue_sources() -> Vec<(PathBuf, String)> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/fmi");
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "rs") && p.file_name().unwrap() != "variables.rs")
+    let mut files: Vec<_> = rust_files(&dir)
+        .into_iter()
+        .filter(|p| p != &dir.join("variables.rs"))
         .map(|p| {
             let text = std::fs::read_to_string(&p).unwrap();
-            (p, text)
+            (p.strip_prefix(&dir).unwrap().to_path_buf(), text)
         })
         .collect();
     files.sort();
     assert!(files.len() >= 10, "{} glue files", files.len());
+    assert!(files.iter().any(|(p, _)| p.starts_with("exports")), "the exports module is read");
     files
 }
 
@@ -76,7 +89,7 @@ fn hits() -> Vec<String> {
     let names_ = variable_names();
     let mut found = Vec::new();
     for (path, text) in glue_sources() {
-        let file = path.file_name().unwrap().to_string_lossy().into_owned();
+        let file = path.display().to_string();
         for (line, token) in tokens(&text) {
             for name in names_.iter().filter(|n| !GENERIC.contains(&n.as_str())) {
                 if names(token, name, &words(name)) {

@@ -8,6 +8,8 @@
 //! forces and torques the sheet exerts on its holder follow from a few mass
 //! moments of the free nodes about the pivot ([`Moments`]), which the modal
 //! space computes from invariants of its basis without expanding a node.
+//! `place` and `ground_velocity` carry the outputs from the holder's frame
+//! into the ground's; `into_frame` turns a ground-frame load into it.
 //!
 //! Vectors have 3 components (z = 0 in 2D); 3 x 3 tensors are row-major.
 
@@ -128,4 +130,37 @@ pub fn spin(theta0: &[f64; 3], theta1: &[f64; 3], h: f64) -> [f64; 3] {
 #[inline]
 pub fn norm(v: &[f64; 3]) -> f64 {
     dot(v, v).sqrt()
+}
+
+/// A rotation vector as the scene can turn: about z alone in 2D.
+pub(super) fn planar(theta: &[f64; 3], d: usize) -> [f64; 3] {
+    if d == 2 {
+        [0.0, 0.0, theta[2]]
+    } else {
+        *theta
+    }
+}
+
+/// R^T v for a ground-frame vector `v` of the scene's dimension (z ignored in 2D).
+pub(super) fn into_frame(r: &[f64; 9], v: &[f64; 3], d: usize) -> [f64; 3] {
+    apply_transposed(r, &std::array::from_fn(|i| if i < d { v[i] } else { 0.0 }))
+}
+
+/// X0 + a + R (x - X0): a position `x` in the frame of a holder at
+/// orientation `r` and displacement `a`, in the ground's.
+pub(super) fn place(pivot: &[f64; 3], a: &[f64; 3], r: &[f64; 9], x: &[f64]) -> [f64; 3] {
+    let d = x.len();
+    let rho: [f64; 3] = std::array::from_fn(|i| if i < d { x[i] - pivot[i] } else { 0.0 });
+    let p = apply(r, &rho);
+    std::array::from_fn(|i| if i < d { pivot[i] + a[i] + p[i] } else { 0.0 })
+}
+
+/// c + R (v + w x (x - X0)): a velocity `v` at `x` in the frame of a holder
+/// at orientation `r` moving at c and turning at w, in the ground's.
+pub(super) fn ground_velocity(pivot: &[f64; 3], c: &[f64; 3], w: &[f64; 3], r: &[f64; 9], v: &[f64], x: &[f64]) -> [f64; 3] {
+    let d = x.len();
+    let rho: [f64; 3] = std::array::from_fn(|i| if i < d { x[i] - pivot[i] } else { 0.0 });
+    let spun = cross(w, &rho);
+    let u = apply(r, &std::array::from_fn(|i| if i < d { v[i] } else { 0.0 } + spun[i]));
+    std::array::from_fn(|i| if i < d { c[i] + u[i] } else { 0.0 })
 }
