@@ -1,5 +1,5 @@
 """Control by choosing modes, through the FMU: the paper's experiments (its
-Figs. 7, 8 and 9) and control of the 3D sheet, as pictures, an animation and
+Figs. 7, 8 and 9) and control of the 3D sheet, as pictures, two animations and
 the numbers that check them.
 
     .venv/bin/python python/control.py [FMU] [--figure fig7,fig8,fig9,3d | all] [--out DIR]
@@ -12,7 +12,7 @@ for 2 s in communication steps of 0.01 s (explicit Newmark, undamped, the
 FMU's defaults). docs/control.md describes what each figure shows.
 
 - fig7: paper-2d-top-row, full space against the 2 lowest modes.
-- fig8: paper-2d-top-corners with nodes HEAVIER times as heavy, three mode
+- fig8: paper-2d-top-corners with nodes 5 times as heavy (HEAVIER), three mode
   sets: (a) the 2 lowest, (b) of the 13 lowest the 10 highest (modes 4-13),
   (c) higher still (modes 14-23); a still and a GIF of the three side by side.
 - fig9: paper-3d-sheet (auxiliary springs), full space against all 126 modes.
