@@ -29,6 +29,7 @@ and from then on B's anchor moves exactly as A.loadNode - A.loadNode(0) does
 """
 
 import argparse
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -204,6 +205,7 @@ def run_master(fmu, h, stop, scheme="jacobi", anchor="relative", positions=False
     finally:
         a.free()
         b.free()
+        shutil.rmtree(unzipdir, ignore_errors=True)
     out = {"time": np.array([r[0] for r in rows])}
     for j, name in enumerate(RECORDED):
         out[name] = np.array([r[j + 1] for r in rows])

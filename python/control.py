@@ -412,13 +412,13 @@ def main(argv=None):
     if unknown:
         p.error(f"unknown figure {', '.join(unknown)} (figures: {', '.join(FIGURES)})")
     os.makedirs(a.out, exist_ok=True)
-    fmu = Fmu(a.fmu)
     makers = {"fig7": fig7, "fig8": fig8, "fig9": fig9, "3d": control3d}
     lines = []
-    for name in names:
-        for line in makers[name](fmu, a.out):
-            print(line, flush=True)
-            lines.append(line)
+    with Fmu(a.fmu) as fmu:
+        for name in names:
+            for line in makers[name](fmu, a.out):
+                print(line, flush=True)
+                lines.append(line)
     with open(os.path.join(a.out, "numbers.txt"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print(f"pictures and numbers.txt in {a.out}")

@@ -10,6 +10,7 @@ Used by python/control.py (the paper's control experiments and control in
 written out with fmpy alone."""
 
 import os
+import shutil
 import tomllib
 from dataclasses import dataclass, field
 
@@ -52,13 +53,23 @@ class Run:
 
 
 class Fmu:
-    """The FMU extracted once; `run` makes one instance per run."""
+    """The FMU extracted once into a temporary directory (`close` removes
+    it; also a context manager); `run` makes one instance per run."""
 
     def __init__(self, path):
         self.path = str(path)
         self.md = read_model_description(self.path)
         self.dir = extract(self.path)
         self.vars = {v.name: v for v in self.md.modelVariables}
+
+    def close(self):
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *_):
+        self.close()
 
     def _set(self, inst, name, value):
         v = self.vars[name]

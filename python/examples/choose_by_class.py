@@ -15,6 +15,7 @@ model)."""
 
 import argparse
 import os
+import shutil
 
 import numpy as np
 from fmpy import extract, read_model_description
@@ -32,7 +33,8 @@ def main(argv=None):
 
     md = read_model_description(a.fmu)
     vr = {v.name: v.valueReference for v in md.modelVariables}
-    fmu = FMU3Slave(guid=md.guid, unzipDirectory=extract(a.fmu), modelIdentifier=md.coSimulation.modelIdentifier, instanceName="sheet")
+    unzipped = extract(a.fmu)  # a temporary directory, removed at the end
+    fmu = FMU3Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier, instanceName="sheet")
     fmu.instantiate()
 
     # The 3D sheet: sizes in Configuration Mode, the rest before initialization.
@@ -67,6 +69,7 @@ def main(argv=None):
         largest = np.maximum(largest, np.abs(x - rest).max(axis=0))
     fmu.terminate()
     fmu.freeInstance()
+    shutil.rmtree(unzipped, ignore_errors=True)
 
     print(f"kept {keep.sum()} of {n_modes} modes ({a.keep})")
     print(f"largest displacement of a node over {t:.2f} s: x {largest[0]:.3e} m, y {largest[1]:.3e} m, z {largest[2]:.3e} m")

@@ -17,6 +17,7 @@ part across the sheet loads those most (`--gravity 0,-9.81,1`).
 import argparse
 import math
 import os
+import shutil
 import sys
 
 import numpy as np
@@ -43,7 +44,8 @@ def main(argv=None):
     md = read_model_description(a.fmu)
     variables = {v.name: v for v in md.modelVariables}
     vr = {name: v.valueReference for name, v in variables.items()}
-    fmu = FMU3Slave(guid=md.guid, unzipDirectory=extract(a.fmu), modelIdentifier=md.coSimulation.modelIdentifier, instanceName="gallery")
+    unzipped = extract(a.fmu)  # a temporary directory, removed at the end
+    fmu = FMU3Slave(guid=md.guid, unzipDirectory=unzipped, modelIdentifier=md.coSimulation.modelIdentifier, instanceName="gallery")
     fmu.instantiate()
     nx = ny = 7 if a.dimension == 3 else 10
     dim, r = a.dimension, a.modes
@@ -68,6 +70,7 @@ def main(argv=None):
     spacing = fmu.getFloat64([vr["spacing"]])[0]
     fmu.terminate()
     fmu.freeInstance()
+    shutil.rmtree(unzipped, ignore_errors=True)
 
     import matplotlib
 

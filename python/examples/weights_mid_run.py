@@ -8,6 +8,7 @@ on). Until then the two runs are the same to the last bit; after it they part.
 
 import argparse
 import os
+import shutil
 
 import numpy as np
 from fmpy import extract, read_model_description
@@ -26,7 +27,7 @@ def main(argv=None):
     md = read_model_description(a.fmu)
     variables = {v.name: v for v in md.modelVariables}
     vr = {name: v.valueReference for name, v in variables.items()}
-    unzipped = extract(a.fmu)
+    unzipped = extract(a.fmu)  # a temporary directory, removed at the end
     nx, ny, dim, n_modes = 10, 10, 2, 12
     # fixedNodes is an enumeration: set through its item's value
     corners = {i.name: int(i.value) for i in variables["fixedNodes"].declaredType.items}["top-corners"]
@@ -67,6 +68,7 @@ def main(argv=None):
     for fmu in sheets:
         fmu.terminate()
         fmu.freeInstance()
+    shutil.rmtree(unzipped, ignore_errors=True)
 
     print(f"largest distance between the two bottom rows: {apart_before:.3e} m up to t = {a.at:.2f} s, {apart_after:.3e} m after")
     return apart_before, apart_after

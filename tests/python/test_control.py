@@ -20,7 +20,8 @@ import control  # noqa: E402
 
 @pytest.fixture(scope="module")
 def fmu(default_fmu):
-    return control.Fmu(default_fmu)
+    with control.Fmu(default_fmu) as f:
+        yield f
 
 
 def test_fig7_two_modes_follow_full_space(fmu):
