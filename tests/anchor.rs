@@ -5,7 +5,7 @@
 //! at a deleted mode), the load patterns of a moving anchor, and the FMI
 //! interface (refusals, fmi3Discard, FMU state).
 
-mod common;
+use crate::common;
 
 use common::*;
 use modal_mass_spring::fmi::variables::vr;

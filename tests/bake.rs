@@ -2,7 +2,7 @@
 //! instance whose parameters match runs bit for bit as one that computes its
 //! set-up; a stale, corrupt or foreign bake is not used, and the log says why.
 
-mod common;
+use crate::common;
 
 use common::*;
 use modal_mass_spring::fmi::exports::{fmi3EnterConfigurationMode, fmi3ExitConfigurationMode};

@@ -1,7 +1,7 @@
 //! The basis options: modes chosen by the loads, the static correction and
 //! the linearization at the loaded equilibrium (docs/method.md, section 3).
 
-mod common;
+use crate::common;
 
 use common::*;
 use modal_mass_spring::fmi::exports::{fmi3EnterInitializationMode, fmi3ExitInitializationMode};

@@ -3,7 +3,7 @@
 //! runs with both integrators stay close to exact forces with the same
 //! basis, and the FMU reports how many springs it keeps.
 
-mod common;
+use crate::common;
 
 use common::*;
 use modal_mass_spring::fmi::variables::vr;

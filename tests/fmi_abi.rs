@@ -11,7 +11,7 @@ use fmi_sys::fmi3::*;
 use modal_mass_spring::fmi::exports::*;
 use modal_mass_spring::fmi::variables::{vr, INSTANTIATION_TOKEN};
 
-mod common;
+use crate::common;
 use common::*;
 
 #[test]

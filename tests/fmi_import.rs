@@ -2,7 +2,7 @@
 //! stepped. Builds target/fmu/ModalMassSpring.fmu with `cargo xtask fmu`
 //! when it is missing or older than the sources.
 
-mod common;
+use crate::common;
 
 use fmi::fmi3::{import::Fmi3Import, CoSimulation, Common, Fmi3Model, GetSet};
 use fmi::traits::FmiImport;

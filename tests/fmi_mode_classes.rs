@@ -4,7 +4,7 @@
 //! in the plane; in 2D nothing leaves the plane and, the canonical grids
 //! being mirror-symmetric, every mode is symmetric or antisymmetric.
 
-mod common;
+use crate::common;
 
 use common::*;
 use modal_mass_spring::fmi::exports::*;

@@ -4,7 +4,7 @@
 //! thousandth step that the outputs are finite and that the total energy
 //! stays where it started.
 
-mod common;
+use crate::common;
 
 use fmi::fmi3::{import::Fmi3Import, CoSimulation, Common, Fmi3Model, GetSet};
 use fmi::traits::FmiImport;

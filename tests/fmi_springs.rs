@@ -3,7 +3,7 @@
 //! without shear and bending springs, in 2D and in 3D (whose auxiliary
 //! springs, to points off the sheet, are left out).
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeSet;
 

@@ -14,7 +14,7 @@
 
 #![allow(clippy::missing_safety_doc)]
 
-mod common;
+use crate::common;
 
 use std::ptr::{null, null_mut};
 

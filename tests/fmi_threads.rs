@@ -3,7 +3,7 @@
 //! through serialization into a fresh instance halfway. Every history must
 //! equal, bit for bit, the same run done alone on one thread.
 
-mod common;
+use crate::common;
 
 use std::sync::{Arc, Barrier};
 

@@ -5,7 +5,7 @@
 //! bit; startOffset = 0 is the canonical run, bit for bit; values out of
 //! range are refused with the instance kept as it was.
 
-mod common;
+use crate::common;
 
 use common::*;
 use modal_mass_spring::fmi::variables::vr;

@@ -4,8 +4,7 @@
 //! once set-up is done. Only allocations of the thread that steps count (the
 //! test harness's own threads allocate when they please).
 
-#[path = "common/counting.rs"]
-mod counting;
+use crate::counting;
 
 use counting::allocations;
 use modal_mass_spring::physics::*;

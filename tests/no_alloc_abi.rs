@@ -7,9 +7,8 @@
 //! allocations of the thread that calls count (the test harness's own
 //! threads allocate when they please).
 
-mod common;
-#[path = "common/counting.rs"]
-mod counting;
+use crate::common;
+use crate::counting;
 
 use common::*;
 use counting::allocations;

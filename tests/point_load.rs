@@ -4,7 +4,7 @@
 //! space under a load switched on mid-run, and the FMI interface (refusals,
 //! Step Mode).
 
-mod common;
+use crate::common;
 
 use common::*;
 use modal_mass_spring::fmi::variables::vr;

@@ -18,7 +18,7 @@
 //! `cargo xtask stability` runs this test with MMS_STABILITY_WRITE=1, which
 //! writes the table into docs/stability.md instead of comparing.
 
-mod common;
+use crate::common;
 
 use std::fmt::Write as _;
 use std::sync::Mutex;

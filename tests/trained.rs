@@ -4,7 +4,7 @@
 //! chaotic, within the window it is predictable (0.5 s and 1 s: its twins
 //! started 1e-7 m away part at about 0.75 s, tests/predictability.rs).
 
-mod common;
+use crate::common;
 
 use common::*;
 use modal_mass_spring::fmi::variables::vr;

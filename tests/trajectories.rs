@@ -9,9 +9,9 @@
 //! names the first step that differs and by how much the energies moved.
 //! A change of the arithmetic of the solver shows here as a failure; where
 //! such a change is intended, `MMS_TRAJECTORIES_WRITE=1 cargo test --release
-//! --test trajectories` records the new trajectories (say why in the commit).
+//! --test suite trajectories::` records the new trajectories (say why in the commit).
 
-mod common;
+use crate::common;
 
 use std::fmt::Write as _;
 use std::path::PathBuf;

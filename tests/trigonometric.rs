@@ -6,7 +6,7 @@
 //! basis and force option, the ports and the weights; the energy of a long
 //! undamped run; the FMU state through the C ABI; the refusal in full space.
 
-mod common;
+use crate::common;
 
 use common::*;
 use modal_mass_spring::fmi::variables::vr;

@@ -9,7 +9,7 @@
 //! holder's work is the change of the sheet's energy plus the damping
 //! loss; refusals keep the state; the FMU state holds the orientation.
 
-mod common;
+use crate::common;
 
 use common::*;
 use modal_mass_spring::fmi::variables::vr;

@@ -273,8 +273,11 @@ fn newest(dir: &Path) -> SystemTime {
 }
 
 /// target/fmu/ModalMassSpring.fmu (release build), made with `cargo xtask
-/// fmu` when it is missing or older than the sources.
+/// fmu` when it is missing or older than the sources; one test at a time
+/// (the tests of the binary run in parallel and would build it together).
 pub fn packed_fmu() -> PathBuf {
+    static BUILDING: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _one_at_a_time = BUILDING.lock().unwrap_or_else(|e| e.into_inner());
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let target = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or(root.join("target"));
     let fmu = target.join("fmu/ModalMassSpring.fmu");

@@ -14,7 +14,7 @@ pub fn main(args: &[String]) -> Result<(), String> {
     }
     let status = Command::new(crate::setup::cargo())
         .current_dir(crate::setup::root())
-        .args(["test", "--release", "--test", "stability", "--", "--nocapture"])
+        .args(["test", "--release", "--test", "suite", "stability::", "--", "--nocapture"])
         .env("MMS_STABILITY_WRITE", "1")
         .status()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
