@@ -12,7 +12,7 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import ROOT
+from conftest import ROOT, cargo_available
 
 sys.path.insert(0, str(ROOT / "python"))
 import control  # noqa: E402
@@ -107,3 +107,12 @@ def test_the_command_writes_every_picture(default_fmu, tmp_path):
         assert name in numbers
     bad = subprocess.run([sys.executable, str(ROOT / "python" / "control.py"), default_fmu, "--figure", "fig10", "--out", str(tmp_path)], capture_output=True, text=True)
     assert bad.returncode != 0 and "unknown figure fig10" in bad.stderr
+
+
+@pytest.mark.skipif(not cargo_available(), reason="cargo is needed to run `cargo xtask control`")
+def test_the_xtask_command(tmp_path):
+    """`cargo xtask control`, as docs/control.md gives it: one figure."""
+    r = subprocess.run(["cargo", "xtask", "control", "--figure", "fig7", "--out", str(tmp_path)], cwd=ROOT, capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert (tmp_path / "fig7.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert (tmp_path / "numbers.txt").read_text().startswith("fig7: 2 lowest modes against full space")
