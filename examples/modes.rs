@@ -105,20 +105,18 @@ fn main() -> Result<(), String> {
         writeln!(table, "{},{w},{hz},{},{},{}", i + 1, classes.out_of_plane[i], classes.symmetry[i], classes.label(i)).unwrap();
     }
 
-    // Node positions (x, y, z) of slot `s` with the free DOFs moved by `u`.
-    let node = |s: usize, u: &dyn Fn(usize) -> f64| -> [f64; 3] {
-        std::array::from_fn(|a| if a < d { scene.rest[s * d + a] + if s < scene.n_free { u(s * d + a) } else { 0.0 } } else { 0.0 })
-    };
+    // The modes on the grid as the FMU's modeShapes gives them: [mode][node][d].
+    let grid = sim.mode_grid_shapes();
+    let rest = |j: usize, a: usize| if a < d { scene.rest[scene.slot_of_node[j] * d + a] } else { 0.0 };
     let spacing = scene.springs.iter().map(|s| s.rest).filter(|&l| l > 0.0).fold(f64::INFINITY, f64::min);
     let mut shapes = String::from("mode,node,rest_x,rest_y,rest_z,x,y,z\n");
-    for i in 0..r {
-        let phi = |dof: usize| basis.phi[dof * r + i];
-        let largest = (0..scene.n_free).map(|k| (0..d).map(|a| phi(k * d + a).powi(2)).sum::<f64>().sqrt()).fold(0.0f64, f64::max);
+    for (i, phi) in grid.chunks(n * d).enumerate() {
+        let largest = phi.chunks(d).map(|p| p.iter().map(|v| v * v).sum::<f64>().sqrt()).fold(0.0f64, f64::max);
         let scale = if largest > 0.0 { 0.5 * spacing / largest } else { 0.0 };
-        for (j, &s) in scene.slot_of_node.iter().enumerate() {
-            let rest = node(s, &|_| 0.0);
-            let moved = node(s, &|dof| scale * phi(dof));
-            writeln!(shapes, "{},{j},{},{},{},{},{},{}", i + 1, rest[0], rest[1], rest[2], moved[0], moved[1], moved[2]).unwrap();
+        for j in 0..n {
+            let at = |a: usize| rest(j, a);
+            let moved = |a: usize| at(a) + if a < d { scale * phi[j * d + a] } else { 0.0 };
+            writeln!(shapes, "{},{j},{},{},{},{},{},{}", i + 1, at(0), at(1), at(2), moved(0), moved(1), moved(2)).unwrap();
         }
     }
 

@@ -24,7 +24,7 @@ use crate::fmi::model::{Computed, Model, StepEnd};
 use crate::fmi::serialize::Reader;
 use crate::fmi::variables::{index_of, vr, Causality, VARIABLES};
 use crate::fmi::{OK, WARNING};
-use crate::physics::{mode_classes, Loads, ModeClasses, Simulator, Snapshot};
+use crate::physics::{Loads, ModeClasses, Simulator, Snapshot};
 
 pub use crate::fmi::params::Params;
 
@@ -172,7 +172,7 @@ impl Model for MassSpring {
         }
         if r == vr::MODE_SHAPES {
             let sim = self.sim.as_ref().expect("outputs are read from a simulator");
-            let shapes = self.shapes.get_or_insert_with(|| sim.mode_shapes().map_or_else(Vec::new, |b| mode_classes::grid_shapes(sim.scene(), b)));
+            let shapes = self.shapes.get_or_insert_with(|| sim.mode_grid_shapes());
             return Computed::Array(shapes);
         }
         let sim = self.sim.as_mut().expect("outputs are read from a simulator");

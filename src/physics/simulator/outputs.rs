@@ -160,6 +160,11 @@ impl Simulator {
     pub fn mode_classes(&self) -> ModeClasses {
         self.engine.modes().map_or_else(ModeClasses::default, |b| mode_classes::classify(self.engine.scene(), b))
     }
+    /// Every mode of [`Self::mode_shapes`] laid out on the grid as the node
+    /// outputs are, `[r][n_nodes][dim]`, 0 on held nodes (empty without). O(n r).
+    pub fn mode_grid_shapes(&self) -> Vec<f64> {
+        self.engine.modes().map_or_else(Vec::new, |b| mode_classes::grid_shapes(self.engine.scene(), b))
+    }
     /// The spring force at generalized coordinates `y` as the space
     /// evaluates it: Phi^T f(x* + Phi y) in the modal space (every spring,
     /// or the cubature), f(x_rest + y) in full space. For diagnostics; the
