@@ -8,7 +8,7 @@
 //!
 //! Columns: `basis_s` is `basis::build` on its own (assembly of K, the
 //! factorization of K − σM, the eigen or Ritz solution, Rayleigh–Ritz),
-//! for a trained basis `snapshots::train` (the training runs, the SVD,
+//! for a trained basis `trained_basis::train` (the training runs, the SVD,
 //! Rayleigh–Ritz);
 //! `setup_s` the whole simulator set-up on the same scene, which builds the
 //! basis again; `other_s` = setup_s − basis_s, the rest of the set-up (the
@@ -17,7 +17,7 @@
 
 use std::time::Instant;
 
-use modal_mass_spring::physics::{basis, snapshots};
+use modal_mass_spring::physics::setup::{basis, trained_basis};
 use modal_mass_spring::physics::{Integrator, ModeSelection, Reduction, Settings, Simulator};
 use modal_mass_spring::scenes;
 
@@ -78,7 +78,7 @@ fn main() {
                 let t0 = Instant::now();
                 // A trained basis is built by its training program (full-space runs, then the SVD).
                 let built = match selection {
-                    ModeSelection::Trained => snapshots::train(scene.clone(), &setup.loads, &setup.settings).map(|d| d.basis),
+                    ModeSelection::Trained => trained_basis::train(scene.clone(), &setup.loads, &setup.settings).map(|d| d.basis),
                     _ => basis::build(&scene, &setup.loads, modes, &setup.settings).map(|b| b.modes),
                 };
                 let basis_s = t0.elapsed().as_secs_f64();

@@ -57,7 +57,7 @@ fn main() {
     let value = |name: &str| args.iter().position(|a| a == name).map(|i| args[i + 1].clone());
     let nx: usize = value("--nx").map_or(30, |v| v.parse().unwrap());
     let seconds: f64 = value("--seconds").map_or(1.0, |v| v.parse().unwrap());
-    let training_time: f64 = value("--training-time").map_or(Training::default().time, |v| v.parse().unwrap());
+    let training_time: f64 = value("--training-time").map_or(TrainingProgram::default().time, |v| v.parse().unwrap());
     let modes: Vec<usize> = {
         let m: Vec<usize> = args.iter().enumerate().filter(|(_, a)| *a == "--modes").map(|(i, _)| args[i + 1].parse().unwrap()).collect();
         if m.is_empty() {
@@ -93,7 +93,7 @@ fn main() {
                 mode_selection: selection,
                 static_correction: correction,
                 force_evaluation: force,
-                training: Training { time: training_time, ..Training::default() },
+                training: TrainingProgram { time: training_time, ..TrainingProgram::default() },
                 ..Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, r)
             };
             let setup = base.with_settings(settings);

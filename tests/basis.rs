@@ -6,9 +6,9 @@ use crate::common;
 use common::*;
 use modal_mass_spring::fmi::exports::{fmi3EnterInitializationMode, fmi3ExitInitializationMode};
 use modal_mass_spring::fmi::variables::vr;
-use modal_mass_spring::physics::basis::{self, Basis};
-use modal_mass_spring::physics::equilibrium::equilibrium;
-use modal_mass_spring::physics::forces::{SpringForces, StiffnessPattern};
+use modal_mass_spring::physics::run::forces::{SpringForces, StiffnessPattern};
+use modal_mass_spring::physics::setup::basis::{self, Basis};
+use modal_mass_spring::physics::setup::equilibrium::equilibrium;
 use modal_mass_spring::physics::*;
 use modal_mass_spring::scenes;
 
@@ -145,7 +145,7 @@ fn the_equilibrium_balances_gravity_and_matches_a_damped_run() {
         let setup = scenes::canonical(name).unwrap();
         let s = setup.grid.build().unwrap();
         let pattern = StiffnessPattern::new(&s);
-        let x = equilibrium(&s, &pattern, &modal_mass_spring::physics::basis::external_load(&s, &setup.loads)).unwrap();
+        let x = equilibrium(&s, &pattern, &modal_mass_spring::physics::setup::basis::external_load(&s, &setup.loads)).unwrap();
         let mut f: Vec<f64> = basis::load_patterns(&s, &setup.loads, false, false).remove(0);
         let gravity = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let springs = SpringForces::new(&s);

@@ -5,8 +5,8 @@
 //! instant; every mode kept, the full space's to round-off; a reduced basis
 //! prepared for the motion close to full space through a swing.
 
-use modal_mass_spring::physics::forces::pull;
-use modal_mass_spring::physics::frame::cross;
+use modal_mass_spring::physics::run::forces::pull;
+use modal_mass_spring::physics::run::frame::cross;
 use modal_mass_spring::physics::*;
 use modal_mass_spring::scenes;
 

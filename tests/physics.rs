@@ -1,9 +1,9 @@
 //! Physics core checks: modes, frequencies, modal vs full space, weights,
 //! sub-stepping, snapshots.
 
-use modal_mass_spring::physics::forces::StiffnessPattern;
-use modal_mass_spring::physics::modes::ModalBasis;
-use modal_mass_spring::physics::scene::Scene;
+use modal_mass_spring::physics::run::forces::StiffnessPattern;
+use modal_mass_spring::physics::setup::modes::ModalBasis;
+use modal_mass_spring::physics::setup::scene::Scene;
 use modal_mass_spring::physics::*;
 use modal_mass_spring::scenes;
 

@@ -9,8 +9,8 @@ use crate::common;
 use common::*;
 use modal_mass_spring::fmi::variables::vr;
 use modal_mass_spring::measures::{trajectory_errors_by_window, Masses};
-use modal_mass_spring::physics::basis::linearize;
-use modal_mass_spring::physics::snapshots::{program, MAX_TIME};
+use modal_mass_spring::physics::setup::basis::linearize;
+use modal_mass_spring::physics::setup::trained_basis::{program, MAX_TIME};
 use modal_mass_spring::physics::*;
 use modal_mass_spring::scenes::{self, Setup};
 
@@ -154,7 +154,7 @@ fn a_trained_set_up_with_cubature_runs_bit_for_bit_from_its_data() {
 
 #[test]
 fn the_training_program_covers_the_set_up_loads_scaled_and_tilted_and_the_announced_motion() {
-    let g_of = |c: &modal_mass_spring::physics::snapshots::Case| c.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let g_of = |c: &modal_mass_spring::physics::setup::trained_basis::Case| c.gravity.iter().map(|x| x * x).sum::<f64>().sqrt();
     let angle = |a: &[f64; 3], b: &[f64; 3]| {
         let dot: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
         let n = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -185,14 +185,14 @@ fn a_training_range_out_of_bounds_is_refused() {
     let setup = scenes::canonical("paper-2d-top-row").unwrap();
     let scene = setup.grid.build().unwrap();
     for (training, quantity) in [
-        (Training { scale: 1.0, ..Training::default() }, Quantity::TrainingScale),
-        (Training { scale: -0.1, ..Training::default() }, Quantity::TrainingScale),
-        (Training { scale: f64::NAN, ..Training::default() }, Quantity::TrainingScale),
-        (Training { tilt: -0.1, ..Training::default() }, Quantity::TrainingTilt),
-        (Training { tilt: 1.6, ..Training::default() }, Quantity::TrainingTilt),
-        (Training { time: 0.0, ..Training::default() }, Quantity::TrainingTime),
-        (Training { time: MAX_TIME * 1.01, ..Training::default() }, Quantity::TrainingTime),
-        (Training { time: f64::INFINITY, ..Training::default() }, Quantity::TrainingTime),
+        (TrainingProgram { scale: 1.0, ..TrainingProgram::default() }, Quantity::TrainingScale),
+        (TrainingProgram { scale: -0.1, ..TrainingProgram::default() }, Quantity::TrainingScale),
+        (TrainingProgram { scale: f64::NAN, ..TrainingProgram::default() }, Quantity::TrainingScale),
+        (TrainingProgram { tilt: -0.1, ..TrainingProgram::default() }, Quantity::TrainingTilt),
+        (TrainingProgram { tilt: 1.6, ..TrainingProgram::default() }, Quantity::TrainingTilt),
+        (TrainingProgram { time: 0.0, ..TrainingProgram::default() }, Quantity::TrainingTime),
+        (TrainingProgram { time: MAX_TIME * 1.01, ..TrainingProgram::default() }, Quantity::TrainingTime),
+        (TrainingProgram { time: f64::INFINITY, ..TrainingProgram::default() }, Quantity::TrainingTime),
     ] {
         let settings = Settings { training, ..trained(4, false, ForceEvaluation::Exact) };
         match Simulator::new(scene.clone(), &settings, &Loads { mode_weights: vec![1.0; 4], ..setup.loads.clone() }) {

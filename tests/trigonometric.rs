@@ -10,11 +10,11 @@ use crate::common;
 
 use common::*;
 use modal_mass_spring::fmi::variables::vr;
-use modal_mass_spring::physics::engine::{Engine, Probe, Stepper};
 use modal_mass_spring::physics::error::StepFailure;
-use modal_mass_spring::physics::frame::{Frame, Moments};
-use modal_mass_spring::physics::integrator::{Propagator, Trigonometric};
-use modal_mass_spring::physics::space::{Diagonal, Layout, Readout, Space};
+use modal_mass_spring::physics::run::engine::{Engine, Probe, Stepper};
+use modal_mass_spring::physics::run::frame::{Frame, Moments};
+use modal_mass_spring::physics::run::integrator::{Propagator, Trigonometric};
+use modal_mass_spring::physics::run::space::{Diagonal, Layout, Readout, Space};
 use modal_mass_spring::physics::*;
 use modal_mass_spring::scenes;
 

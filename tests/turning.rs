@@ -13,8 +13,8 @@ use crate::common;
 
 use common::*;
 use modal_mass_spring::fmi::variables::vr;
-use modal_mass_spring::physics::forces::{SpringForces, SpringScratch, StiffnessPattern};
-use modal_mass_spring::physics::frame::{apply, apply_transposed, cross, dot, rotation};
+use modal_mass_spring::physics::run::forces::{SpringForces, SpringScratch, StiffnessPattern};
+use modal_mass_spring::physics::run::frame::{apply, apply_transposed, cross, dot, rotation};
 use modal_mass_spring::physics::*;
 use modal_mass_spring::scenes;
 use nalgebra::{DMatrix, DVector};

@@ -171,7 +171,7 @@ pub fn plan_scene(p: &Grid, variants: &[Variant], quick: bool, variants_only: bo
     // of those, only all modes are run (set-up alone takes tens of
     // seconds at a few thousand DOFs).
     mode_counts.retain(|&r| r <= 64 || r * 16 <= n);
-    if n <= modes::MAX_DENSE_DOFS {
+    if n <= setup::modes::MAX_DENSE_DOFS {
         mode_counts.push(n);
     }
     let springs = scene.springs.len();

@@ -6,7 +6,7 @@ use crate::fmi::params::Params;
 use crate::fmi::variables::{index_of, vr, SCENES};
 use crate::measures::twin_offset;
 use crate::options::{FixedNodes, ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction};
-use crate::physics::{Grid, Loads, PhysicsError, Settings, SetupData, Simulator, Training};
+use crate::physics::{Grid, Loads, PhysicsError, Settings, SetupData, Simulator, TrainingProgram};
 
 impl Params {
     /// The start values of the canonical scene `name` (the `[scenes.NAME]`
@@ -56,7 +56,7 @@ impl Params {
             cubature_tolerance: self.scalar(vr::CUBATURE_TOLERANCE),
             max_internal_step: self.scalar(vr::MAX_INTERNAL_STEP),
             substepping: true,
-            training: Training { scale: self.scalar(vr::TRAINING_SCALE), tilt: self.scalar(vr::TRAINING_TILT), time: self.scalar(vr::TRAINING_TIME) },
+            training: TrainingProgram { scale: self.scalar(vr::TRAINING_SCALE), tilt: self.scalar(vr::TRAINING_TILT), time: self.scalar(vr::TRAINING_TIME) },
         }
     }
 

@@ -276,7 +276,7 @@ pub enum PhysicsError {
 
 impl PhysicsError {
     /// The set-up refused the pairing of a space and a scheme, whatever the
-    /// scene and the numbers (a scheme's [`check`](crate::physics::integrator::Scheme::check)):
+    /// scene and the numbers (a scheme's [`check`](crate::physics::run::integrator::Scheme::check)):
     /// what tests, benchmarks and the study skip when they run every pair.
     pub fn refuses_pairing(&self) -> bool {
         matches!(self, PhysicsError::SchemeNeedsDiagonal { .. })

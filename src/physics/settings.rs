@@ -6,7 +6,7 @@
 
 pub use crate::options::{ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction};
 
-/// Everything the set-up of a [`super::Simulator`] chooses besides the scene and the loads.
+/// Everything the set-up of a [`crate::physics::Simulator`] chooses besides the scene and the loads.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
     /// Space the equations live in (`docs/method.md`, sections 3 and 4).
@@ -44,17 +44,17 @@ pub struct Settings {
     /// explicit integrator stable. Only tests switch this off, to show why it exists.
     pub substepping: bool,
     /// With [`ModeSelection::Trained`]: the loads its training program runs.
-    pub training: Training,
+    pub training: TrainingProgram,
 }
 
 /// The range a trained basis is trained for (`docs/method.md`, section 3;
-/// [`crate::physics::snapshots`]): the full-space model runs from rest under
+/// [`crate::physics::setup::trained_basis`]): the full-space model runs from rest under
 /// the set-up gravity scaled by 1 - `scale`, 1 and 1 + `scale`, and tilted by
 /// `tilt` either way about each axis normal to it that the scene can tilt
 /// about, for `time` each (plus the holder's accelerations and spins the
 /// settings announce, and the point load's range).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Training {
+pub struct TrainingProgram {
     /// Relative change of gravity's magnitude, in [0, 1).
     pub scale: f64,
     /// Tilt of gravity's direction [rad], in [0, pi/2].
@@ -63,10 +63,10 @@ pub struct Training {
     pub time: f64,
 }
 
-impl Default for Training {
+impl Default for TrainingProgram {
     /// 0.7 to 1.3 times the set-up gravity, tilted up to 20 degrees, 1 s per run.
     fn default() -> Self {
-        Training { scale: 0.3, tilt: 20f64.to_radians(), time: 1.0 }
+        TrainingProgram { scale: 0.3, tilt: 20f64.to_radians(), time: 1.0 }
     }
 }
 
@@ -88,7 +88,7 @@ impl Settings {
             cubature_tolerance: 0.01,
             max_internal_step: 0.01,
             substepping: true,
-            training: Training::default(),
+            training: TrainingProgram::default(),
         }
     }
 }

@@ -1,0 +1,23 @@
+//! The run floor: what steps the sheet and reads it, built once at set-up
+//! and then only written by the steps.
+//!
+//! - [`forces`]: exact spring forces, tangent stiffness, sparsity (the kernel);
+//! - [`space`]: where the equations M y'' + C y' = h(y) live (modal, full),
+//!   each a constant model with its own scratch;
+//! - [`integrator`]: the schemes (explicit and implicit Newmark,
+//!   trigonometric), written once against [`space::Space`];
+//! - [`engine`]: a space and a scheme bound together;
+//! - [`frame`]: the holder's frame and the mass moments of the sheet in it;
+//! - [`state`]: [`state::State`] and [`state::Loads`], what changes while running;
+//! - [`simulator`]: set-up, sub-stepping, divergence checks, outputs.
+//!
+//! One modal force evaluation is the pipeline `expand` (q -> x) -> exact
+//! spring forces in physical space -> `project` (Phi^T f).
+
+pub mod engine;
+pub mod forces;
+pub mod frame;
+pub mod integrator;
+pub mod simulator;
+pub mod space;
+pub mod state;

@@ -1,0 +1,561 @@
+//! The full space: the same model on every free DOF, no reduction
+//! (`docs/method.md`, section 4), the reference of every comparison.
+//!
+//! y = u, the displacements of the free DOFs from x*, x = x* + u. M is the
+//! lumped diagonal, C = alpha M + beta K0 (Rayleigh, K0 the stiffness at x*,
+//! so the modal and full runs share one damping model). Linear systems (the
+//! implicit Newton matrix, and the explicit velocity update when beta > 0)
+//! are solved with faer's sparse Cholesky LL^T, or LDL^T where compressed
+//! springs make the Newton matrix indefinite; the symbolic analysis is made
+//! at set-up.
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LdltRef, LltRef, SymbolicCholesky, SymmetricOrdering};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, MatMut, Par, Side};
+
+use super::equations::{Diagonal, Layout, Readout, Space};
+use crate::physics::error::{PhysicsError, StepFailure};
+use crate::physics::run::forces::{linearize, omega_sq_bound_full, SpringForces, SpringScratch, StiffnessPattern};
+use crate::physics::run::frame::{add_outer, cross, dot, Frame, Moments};
+use crate::physics::run::state::Loads;
+use crate::physics::settings::Settings;
+use crate::physics::setup::basis;
+use crate::physics::setup::modes::ModalBasis;
+use crate::physics::setup::scene::Scene;
+
+/// The constant model of the full-space equations.
+pub struct Full {
+    scene: Scene,
+    springs: SpringForces,
+    pattern: StiffnessPattern,
+    /// Upper triangle of K0, the stiffness at x*.
+    k0: Vec<f64>,
+    symbolic: SymbolicCholesky<usize>,
+    /// Modes whose coordinates and frequencies are reported, if any.
+    reported: Option<ModalBasis>,
+    /// x_rest - x* of the reported modes, when x* is not the rest positions.
+    reported_offset: Option<Vec<f64>>,
+    frequencies: Vec<f64>,
+    omega_sq_bound: f64,
+    newton_scale: f64,
+    /// The pivot X0.
+    pivot: [f64; 3],
+    /// In 3D, per free node, the positions of its (x, y), (x, z), (y, z)
+    /// entries in the stiffness pattern (SKIP where none).
+    node_pairs: Vec<[usize; 3]>,
+}
+
+/// No entry in the pattern.
+const SKIP: usize = usize::MAX;
+
+/// Load terms and scratch of a full-space run.
+pub struct FullWork {
+    alpha: f64,
+    beta: f64,
+    /// M g plus the point load, per DOF.
+    gravity: Vec<f64>,
+    /// Slot positions and elastic energy of the last force evaluation.
+    x: Vec<f64>,
+    elastic: f64,
+    springs: SpringScratch,
+    /// C v.
+    cv: Vec<f64>,
+    /// Values of the matrix to factor, on the stiffness pattern.
+    matrix: Vec<f64>,
+    l_values: Vec<f64>,
+    /// `l_values` holds LDL^T (the matrix was indefinite), not LL^T.
+    indefinite: bool,
+    mem: MemBuffer,
+    /// (dt, alpha, beta) for which `l_values` holds M + dt/2 C (explicit, beta > 0).
+    explicit_factor: Option<(f64, f64, f64)>,
+    /// The holder's frame has left its rest orientation ([`Space::turn`]), and its spin.
+    turning: bool,
+    spin: [f64; 3],
+    /// The right side and the previous iterate of the Coriolis velocity update.
+    rhs: Vec<f64>,
+    previous: Vec<f64>,
+}
+
+impl Full {
+    /// Assembles the stiffness at rest and its symbolic Cholesky analysis;
+    /// builds the basis of `reported_modes` vectors `options` ask for (under
+    /// the set-up `loads`) when that is not 0, to report its coordinates.
+    pub fn new(scene: Scene, loads: &Loads, settings: &Settings) -> Result<Self, PhysicsError> {
+        let reported_modes = settings.n_modes;
+        let (pattern, k0) = linearize(&scene);
+        let (reported, reported_offset) = if reported_modes > 0 {
+            let b = basis::build(&scene, loads, reported_modes, settings)?;
+            let offset = (!b.at_rest).then(|| (0..scene.n_dofs()).map(|k| scene.rest[k] - b.point[k]).collect());
+            (Some(b.modes), offset)
+        } else {
+            (None, None)
+        };
+        let n = scene.n_dofs();
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx);
+        let symbolic = factorize_symbolic_cholesky(sym, Side::Upper, SymmetricOrdering::Amd, Default::default())
+            .map_err(|e| PhysicsError::LinearAlgebra { what: "sparse Cholesky analysis", detail: format!("{e:?}") })?;
+        let node_pairs = if scene.dim == 3 {
+            let find =
+                |r: usize, c: usize| pattern.row_idx[pattern.col_ptr[c]..pattern.col_ptr[c + 1]].binary_search(&r).map_or(SKIP, |i| pattern.col_ptr[c] + i);
+            (0..scene.n_free).map(|k| [find(3 * k, 3 * k + 1), find(3 * k, 3 * k + 2), find(3 * k + 1, 3 * k + 2)]).collect()
+        } else {
+            Vec::new()
+        };
+        Ok(Full {
+            pivot: scene.pivot(),
+            node_pairs,
+            springs: SpringForces::new(&scene),
+            frequencies: reported.as_ref().map(|b| b.frequencies()).unwrap_or_default(),
+            omega_sq_bound: omega_sq_bound_full(&scene),
+            newton_scale: scene.length_scale().max(1e-300),
+            reported,
+            reported_offset,
+            symbolic,
+            pattern,
+            k0,
+            scene,
+        })
+    }
+
+    /// cv = C v = alpha M v + beta K0 v.
+    fn damping_times(&self, v: &[f64], w: &mut FullWork) {
+        let mass = &self.scene.dof_mass;
+        if w.beta != 0.0 {
+            self.pattern.sym_matvec(&self.k0, v, &mut w.cv);
+            for k in 0..v.len() {
+                w.cv[k] = w.alpha * mass[k] * v[k] + w.beta * w.cv[k];
+            }
+        } else {
+            for k in 0..v.len() {
+                w.cv[k] = w.alpha * mass[k] * v[k];
+            }
+        }
+    }
+
+    /// Factorizes `c_m M + c_k K0 (+ K(x) if tangent)` into `w.l_values`.
+    fn factorize(&self, c_m: f64, c_k: f64, tangent: bool, w: &mut FullWork) -> Result<(), StepFailure> {
+        for (m, k) in w.matrix.iter_mut().zip(&self.k0) {
+            *m = c_k * k;
+        }
+        for (k, &pos) in self.pattern.diag.iter().enumerate() {
+            w.matrix[pos] += c_m * self.scene.dof_mass[k];
+        }
+        if tangent {
+            self.pattern.add_tangent(&self.scene, &w.x, 1.0, &mut w.matrix);
+        }
+        self.factorize_matrix(w)
+    }
+
+    /// The Newton matrix c_m M + c_k K0 + K(x) - m (Omega^2 I - Omega Omega^T) per node.
+    fn factorize_with_spin(&self, c_m: f64, c_k: f64, spin: &[f64; 3], w: &mut FullWork) -> Result<(), StepFailure> {
+        if *spin == [0.0; 3] {
+            return self.factorize(c_m, c_k, true, w);
+        }
+        for (m, k) in w.matrix.iter_mut().zip(&self.k0) {
+            *m = c_k * k;
+        }
+        let (d, w2) = (self.scene.dim, dot(spin, spin));
+        for (k, &pos) in self.pattern.diag.iter().enumerate() {
+            let i = k % d;
+            w.matrix[pos] += c_m * self.scene.dof_mass[k] - self.scene.dof_mass[k] * (w2 - spin[i] * spin[i]);
+        }
+        for (k, pairs) in self.node_pairs.iter().enumerate() {
+            let m = self.scene.dof_mass[3 * k];
+            for (&pos, (a, b)) in pairs.iter().zip([(0, 1), (0, 2), (1, 2)]) {
+                if pos != SKIP {
+                    w.matrix[pos] += m * spin[a] * spin[b];
+                }
+            }
+        }
+        self.pattern.add_tangent(&self.scene, &w.x, 1.0, &mut w.matrix);
+        self.factorize_matrix(w)
+    }
+
+    /// Factorizes `w.matrix` into `w.l_values`: LL^T, else LDL^T.
+    fn factorize_matrix(&self, w: &mut FullWork) -> Result<(), StepFailure> {
+        let n = self.scene.n_dofs();
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &self.pattern.col_ptr, None, &self.pattern.row_idx);
+        let a = SparseColMatRef::new(sym, &w.matrix);
+        let stack = MemStack::new(&mut w.mem);
+        let llt = self.symbolic.factorize_numeric_llt(&mut w.l_values, a, Side::Upper, LltRegularization::default(), Par::Seq, stack, Default::default());
+        w.indefinite = llt.is_err();
+        if !w.indefinite {
+            return Ok(());
+        }
+        // Springs in compression have negative transverse stiffness; with
+        // stiff springs it can outweigh M / (beta dt^2). Newton still
+        // converges on the indefinite matrix: factor it as LDL^T.
+        let stack = MemStack::new(&mut w.mem);
+        let regularization = LdltRegularization { dynamic_regularization_signs: None, dynamic_regularization_delta: 0.0, dynamic_regularization_epsilon: 0.0 };
+        self.symbolic
+            .factorize_numeric_ldlt(&mut w.l_values, a, Side::Upper, regularization, Par::Seq, stack, Default::default())
+            .map(|_| ())
+            .map_err(|_| StepFailure::Buckled)
+    }
+}
+
+impl Full {
+    /// Adds s 2 (Omega x v) per node to `out`, times m_k when `mass`.
+    fn add_coriolis(&self, v: &[f64], spin: [f64; 3], s: f64, mass: bool, out: &mut [f64]) {
+        let d = self.scene.dim;
+        for (k, o) in out.chunks_exact_mut(d).enumerate() {
+            let vel: [f64; 3] = std::array::from_fn(|i| if i < d { v[k * d + i] } else { 0.0 });
+            let c = cross(&spin, &vel);
+            let m = if mass { self.scene.dof_mass[k * d] } else { 1.0 };
+            for i in 0..d {
+                o[i] += s * 2.0 * m * c[i];
+            }
+        }
+    }
+
+    /// Solves (M + dt/2 C + dt M [Omega]x) v1 = rhs, `v1` holding rhs on entry.
+    fn coriolis_velocity(&self, dt: f64, w: &mut FullWork, v1: &mut [f64]) -> Result<(), StepFailure> {
+        let (d, spin) = (self.scene.dim, w.spin);
+        let mass = &self.scene.dof_mass;
+        if w.beta == 0.0 {
+            // Per node m ((1 + dt/2 alpha) I + [dt Omega]x) v = b: with a = 1 + dt/2 alpha, s = dt Omega, c = b / m,
+            // v = (a^2 c - a (s x c) + (s . c) s) / (a (a^2 + |s|^2)).
+            let a = 1.0 + 0.5 * dt * w.alpha;
+            let s: [f64; 3] = std::array::from_fn(|i| dt * spin[i]);
+            let den = a * (a * a + dot(&s, &s));
+            for (k, vk) in v1.chunks_exact_mut(d).enumerate() {
+                let c: [f64; 3] = std::array::from_fn(|i| if i < d { vk[i] / mass[k * d] } else { 0.0 });
+                let (sc, along) = (cross(&s, &c), dot(&s, &c));
+                for i in 0..d {
+                    vk[i] = (a * a * c[i] - a * sc[i] + along * s[i]) / den;
+                }
+            }
+            return Ok(());
+        }
+        // v1 = (M + dt/2 C)^-1 (rhs - dt M (Omega x v1)), from v1 = 0.
+        let key = (dt, w.alpha, w.beta);
+        if w.explicit_factor != Some(key) {
+            w.explicit_factor = None;
+            self.factorize(1.0 + 0.5 * dt * w.alpha, 0.5 * dt * w.beta, false, w)?;
+            w.explicit_factor = Some(key);
+        }
+        w.rhs.copy_from_slice(v1);
+        w.previous.fill(0.0);
+        for _ in 0..MAX_CORIOLIS_ITERATIONS {
+            v1.copy_from_slice(&w.rhs);
+            // rhs - dt M (Omega x previous)
+            self.add_coriolis(&w.previous, spin, -0.5 * dt, true, v1);
+            self.solve(w, v1);
+            let change = v1.iter().zip(&w.previous).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            let size = v1.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+            w.previous.copy_from_slice(v1);
+            if change <= 1e-13 * size {
+                return Ok(());
+            }
+        }
+        Err(StepFailure::CoriolisNotConverged { turn: dt * dot(&spin, &spin).sqrt(), dt })
+    }
+}
+
+/// Iterates of the Coriolis velocity update before a step is refused.
+const MAX_CORIOLIS_ITERATIONS: usize = 100;
+
+impl Space for Full {
+    type Work = FullWork;
+
+    fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    fn layout(&self) -> Layout<'_> {
+        Layout {
+            scene: &self.scene,
+            coordinates: self.scene.n_dofs(),
+            kept_modes: None,
+            springs: self.scene.springs.len(),
+            frequencies: &self.frequencies,
+            newton_scale: self.newton_scale,
+            trained: None,
+        }
+    }
+
+    fn modes(&self) -> Option<&ModalBasis> {
+        self.reported.as_ref()
+    }
+
+    fn work(&self) -> FullWork {
+        let n = self.scene.n_dofs();
+        let req = StackReq::any_of(&[
+            self.symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
+            self.symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
+            self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
+        ]);
+        FullWork {
+            alpha: 0.0,
+            beta: 0.0,
+            gravity: vec![0.0; n],
+            x: self.scene.rest.clone(),
+            elastic: 0.0,
+            springs: self.springs.scratch(&self.scene),
+            cv: vec![0.0; n],
+            matrix: vec![0.0; self.pattern.nnz()],
+            l_values: vec![0.0; self.symbolic.len_val()],
+            indefinite: false,
+            mem: MemBuffer::new(req),
+            explicit_factor: None,
+            turning: false,
+            spin: [0.0; 3],
+            rhs: vec![0.0; n],
+            previous: vec![0.0; n],
+        }
+    }
+
+    /// u = 0: the full space measures from the rest positions.
+    fn rest_coordinates(&self, u: &mut [f64]) {
+        u.fill(0.0);
+    }
+
+    fn apply_loads(&self, loads: &Loads, w: &mut FullWork) {
+        let d = self.scene.dim;
+        w.alpha = loads.damping_alpha;
+        w.beta = loads.damping_beta;
+        for (k, g) in w.gravity.iter_mut().enumerate() {
+            *g = self.scene.dof_mass[k] * loads.gravity[k % d];
+        }
+        // The point load joins M g (`docs/method.md`, section 8).
+        if let Some((dof, f)) = loads.point_force(&self.scene) {
+            for (g, fi) in w.gravity[dof..dof + d].iter_mut().zip(f) {
+                *g += fi;
+            }
+        }
+        w.turning = false;
+    }
+
+    /// M R^T g + R^T f_p per DOF, and the spin.
+    fn turn(&self, loads: &Loads, frame: &Frame, w: &mut FullWork) {
+        let d = self.scene.dim;
+        for (k, g) in w.gravity.iter_mut().enumerate() {
+            *g = self.scene.dof_mass[k] * frame.gravity[k % d];
+        }
+        if let Some((dof, _)) = loads.point_force(&self.scene) {
+            for (i, g) in w.gravity[dof..dof + d].iter_mut().enumerate() {
+                *g += frame.load[i];
+            }
+        }
+        w.turning = true;
+        w.spin = frame.spin;
+    }
+
+    /// u' += c x (x_rest + u - X0) on every free node.
+    fn add_rotation_rate(&self, _loads: &Loads, c: &[f64; 3], u: &[f64], v: &mut [f64]) {
+        let d = self.scene.dim;
+        for (k, vk) in v.chunks_exact_mut(d).enumerate() {
+            let rho: [f64; 3] = std::array::from_fn(|i| if i < d { self.scene.rest[k * d + i] + u[k * d + i] - self.pivot[i] } else { 0.0 });
+            let dv = cross(c, &rho);
+            for i in 0..d {
+                vk[i] += dv[i];
+            }
+        }
+    }
+
+    /// h(u) = f_springs(x* + u) + M g + f_p; turning, with M R^T g + R^T f_p
+    /// and the centrifugal force m (Omega^2 rho - Omega (Omega . rho)), rho = x - X0.
+    fn force(&self, _loads: &Loads, u: &[f64], w: &mut FullWork, h: &mut [f64]) {
+        for k in 0..u.len() {
+            w.x[k] = self.scene.rest[k] + u[k];
+        }
+        h.copy_from_slice(&w.gravity);
+        w.elastic = self.springs.add_to(&self.scene, &w.x, &mut w.springs, h);
+        if w.turning {
+            let (d, spin) = (self.scene.dim, w.spin);
+            let w2 = dot(&spin, &spin);
+            for (k, hk) in h.chunks_exact_mut(d).enumerate() {
+                let m = self.scene.dof_mass[k * d];
+                let rho: [f64; 3] = std::array::from_fn(|i| if i < d { w.x[k * d + i] - self.pivot[i] } else { 0.0 });
+                let along = dot(&spin, &rho);
+                for i in 0..d {
+                    hk[i] += m * (w2 * rho[i] - spin[i] * along);
+                }
+            }
+        }
+    }
+
+    /// Turning, (M + dt/2 C + dt M [Omega]x) v1 = the same right side: the
+    /// Coriolis force taken with the damping; node by node in closed form
+    /// without stiffness-proportional damping, else by fixed-point
+    /// iteration on the Coriolis term, which contracts by dt |Omega| per iterate.
+    fn explicit_velocity(&self, dt: f64, v: &[f64], a: &[f64], h: &[f64], w: &mut FullWork, v1: &mut [f64]) -> Result<(), StepFailure> {
+        let mass = &self.scene.dof_mass;
+        for k in 0..v1.len() {
+            v1[k] = mass[k] * (v[k] + 0.5 * dt * a[k]) + 0.5 * dt * h[k];
+        }
+        if w.turning && w.spin != [0.0; 3] {
+            return self.coriolis_velocity(dt, w, v1);
+        }
+        if w.beta != 0.0 {
+            // (M + dt/2 C) is constant while dt and the damping are: factor once.
+            let key = (dt, w.alpha, w.beta);
+            if w.explicit_factor != Some(key) {
+                w.explicit_factor = None;
+                self.factorize(1.0 + 0.5 * dt * w.alpha, 0.5 * dt * w.beta, false, w)?;
+                w.explicit_factor = Some(key);
+            }
+            self.solve(w, v1);
+        } else {
+            for k in 0..v1.len() {
+                v1[k] /= mass[k] * (1.0 + 0.5 * dt * w.alpha);
+            }
+        }
+        Ok(())
+    }
+
+    fn acceleration(&self, v: &[f64], h: &[f64], w: &mut FullWork, a: &mut [f64]) {
+        self.damping_times(v, w);
+        for k in 0..a.len() {
+            a[k] = (h[k] - w.cv[k]) / self.scene.dof_mass[k];
+        }
+        if w.turning {
+            self.add_coriolis(v, w.spin, -1.0, false, a);
+        }
+    }
+
+    fn residual(&self, v: &[f64], a: &[f64], h: &[f64], w: &mut FullWork, r: &mut [f64]) {
+        self.damping_times(v, w);
+        for k in 0..r.len() {
+            r[k] = -(self.scene.dof_mass[k] * a[k] + w.cv[k] - h[k]);
+        }
+        if w.turning {
+            self.add_coriolis(v, w.spin, -1.0, true, r);
+        }
+    }
+
+    /// c_m M + c_c (alpha M + beta K0) + K(x): the tangent of -h is the
+    /// stiffness K(x). Turning, the centrifugal force's softening
+    /// -m (Omega^2 I - Omega Omega^T) joins it; the Coriolis term's skew part
+    /// c_c 2 M [Omega]x is left out of the symmetric factor, so Newton then
+    /// converges at a rate of about dt |Omega| per iterate instead of quadratically.
+    fn factor(&self, _loads: &Loads, c_m: f64, c_c: f64, w: &mut FullWork) -> Result<(), StepFailure> {
+        w.explicit_factor = None;
+        let spin = if w.turning { w.spin } else { [0.0; 3] };
+        self.factorize_with_spin(c_m + c_c * w.alpha, c_c * w.beta, &spin, w)
+    }
+
+    fn solve(&self, w: &mut FullWork, rhs: &mut [f64]) {
+        let n = rhs.len();
+        let stack = MemStack::new(&mut w.mem);
+        let rhs = MatMut::from_column_major_slice_mut(rhs, n, 1);
+        if w.indefinite {
+            LdltRef::<usize, f64>::new(&self.symbolic, &w.l_values).solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+        } else {
+            LltRef::<usize, f64>::new(&self.symbolic, &w.l_values).solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+        }
+    }
+
+    fn omega_sq_bound(&self, _loads: &Loads) -> f64 {
+        self.omega_sq_bound
+    }
+
+    /// K0 and C couple the DOFs: no diagonal form.
+    fn diagonal<'a>(&'a self, _w: &'a FullWork) -> Option<Diagonal<'a>> {
+        None
+    }
+
+    /// u' += 1 c on every free node.
+    fn add_translation_rate(&self, _loads: &Loads, c: &[f64; 3], v: &mut [f64]) {
+        let d = self.scene.dim;
+        for (k, vk) in v.iter_mut().enumerate() {
+            *vk += c[k % d];
+        }
+    }
+}
+
+impl Readout for Full {
+    fn spring_force(&self, u: &[f64], w: &mut FullWork, out: &mut [f64]) {
+        for k in 0..u.len() {
+            w.x[k] = self.scene.rest[k] + u[k];
+        }
+        out.fill(0.0);
+        w.elastic = self.springs.add_to(&self.scene, &w.x, &mut w.springs, out);
+    }
+
+    fn positions<'w>(&self, _u: &[f64], w: &'w mut FullWork) -> &'w [f64] {
+        &w.x
+    }
+
+    fn elastic_energy(&self, _u: &[f64], w: &mut FullWork) -> f64 {
+        w.elastic
+    }
+
+    /// -(M g)^T u, summed node by node, and -f_p^T u at the load node.
+    fn gravity_potential(&self, loads: &Loads, u: &[f64], _w: &FullWork) -> f64 {
+        let d = self.scene.dim;
+        let g = &loads.gravity;
+        let work: f64 = u.chunks_exact(d).zip(self.scene.dof_mass.chunks_exact(d)).map(|(u, m)| (0..d).map(|i| m[i] * g[i] * u[i]).sum::<f64>()).sum();
+        match loads.point_force(&self.scene) {
+            Some((dof, f)) => -work - f.iter().zip(&u[dof..dof + d]).map(|(f, u)| f * u).sum::<f64>(),
+            None => -work,
+        }
+    }
+
+    fn kinetic_energy(&self, v: &[f64]) -> f64 {
+        0.5 * v.iter().zip(&self.scene.dof_mass).map(|(v, m)| m * v * v).sum::<f64>()
+    }
+
+    fn slot_velocity(&self, v: &[f64], slot: usize) -> [f64; 3] {
+        let d = self.scene.dim;
+        std::array::from_fn(|i| if i < d { v[slot * d + i] } else { 0.0 })
+    }
+
+    fn momentum(&self, v: &[f64]) -> [f64; 3] {
+        let (d, mut p) = (self.scene.dim, [0.0; 3]);
+        for (k, (vk, m)) in v.iter().zip(&self.scene.dof_mass).enumerate() {
+            p[k % d] += m * vk;
+        }
+        p
+    }
+
+    fn first_moment(&self, u: &[f64]) -> [f64; 3] {
+        let (d, pivot, mut s) = (self.scene.dim, self.scene.pivot(), [0.0; 3]);
+        for (k, (uk, m)) in u.iter().zip(&self.scene.dof_mass).enumerate() {
+            s[k % d] += m * (self.scene.rest[k] + uk - pivot[k % d]);
+        }
+        s
+    }
+
+    /// Node by node, rho = x_rest + u - X0.
+    fn moments(&self, u: &[f64], v: &[f64]) -> Moments {
+        let (d, pivot) = (self.scene.dim, self.scene.pivot());
+        let mut out = Moments::default();
+        for (k, m) in self.scene.dof_mass.iter().step_by(d).enumerate() {
+            let rho: [f64; 3] = std::array::from_fn(|i| if i < d { self.scene.rest[k * d + i] + u[k * d + i] - pivot[i] } else { 0.0 });
+            let vel: [f64; 3] = std::array::from_fn(|i| if i < d { v[k * d + i] } else { 0.0 });
+            for i in 0..3 {
+                out.first[i] += m * rho[i];
+                out.momentum[i] += m * vel[i];
+            }
+            add_outer(&mut out.second, *m, &rho, &rho);
+            add_outer(&mut out.flux, *m, &vel, &rho);
+        }
+        out
+    }
+
+    fn dof_velocities(&self, v: &[f64], out: &mut [f64]) {
+        out.copy_from_slice(v);
+    }
+
+    /// Every force is represented: 0.
+    fn force_residual(&self, _loads: &Loads, _u: &[f64], _w: &mut FullWork) -> f64 {
+        0.0
+    }
+
+    /// q = Phi^T M (x - x*) on the reported modes.
+    fn modal_coordinates(&self, u: &[f64], out: &mut [f64]) {
+        if let Some(b) = &self.reported {
+            match &self.reported_offset {
+                None => b.project_displacement(&self.scene.dof_mass, u, out),
+                Some(offset) => {
+                    let d: Vec<f64> = u.iter().zip(offset).map(|(a, b)| a + b).collect();
+                    b.project_displacement(&self.scene.dof_mass, &d, out);
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,437 @@
+//! The modal basis a scene needs (`docs/method.md`, section 3): where to
+//! linearize, which modes to keep, and whether to add the static response
+//! to the loads.
+//!
+//! - **Linearization** at rest (the paper), or at the static equilibrium
+//!   under the loads ([`crate::physics::setup::equilibrium`]), where the stiffness includes
+//!   the geometric stiffness of the stretched springs.
+//! - **Selection**: the r lowest modes (the paper), or the r modes that
+//!   carry most of the static response to the loads, ranked by
+//!   |φ_iᵀ f| / λ_i for each load pattern f. On scenes up to
+//!   [`DENSE_CANDIDATES`] free DOFs every mode is a candidate; above, the
+//!   candidates are the Ritz pairs of a Krylov space grown from K⁻¹ f
+//!   (load-dependent Ritz vectors, Wilson, Yuan and Dickens 1982), which
+//!   reaches the loaded modes from one sparse factorization however many
+//!   unloaded modes lie below them.
+//! - **Static correction**: the static responses K⁻¹ f join the kept modes;
+//!   the enriched set is M-orthonormalized and diagonalized in its own
+//!   span (Rayleigh–Ritz), so every basis vector has a frequency and
+//!   Φᵀ M Φ = I, Φᵀ K Φ = diag(λ) hold as for eigenmodes. The number of
+//!   modes counts every basis vector.
+
+use faer::linalg::matmul::matmul;
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Accum, Col, Mat, MatMut, MatRef, Par, Side};
+
+use crate::physics::error::PhysicsError;
+use crate::physics::run::forces::StiffnessPattern;
+use crate::physics::run::frame::cross;
+use crate::physics::run::state::Loads;
+use crate::physics::settings::{Linearization, ModeSelection, Settings};
+use crate::physics::setup::equilibrium::equilibrium;
+use crate::physics::setup::modes::ModalBasis;
+use crate::physics::setup::scene::Scene;
+
+/// Scenes up to this many free DOFs rank every mode (a dense decomposition);
+/// larger ones rank load-dependent Ritz pairs.
+pub const DENSE_CANDIDATES: usize = 1500;
+/// Krylov vectors per kept mode in the load-dependent Ritz space (and at least this many more than kept).
+const RITZ_FACTOR: usize = 4;
+const RITZ_EXTRA: usize = 16;
+/// A vector whose M-norm falls below this fraction of its own after
+/// orthogonalization against the basis is taken as already in it.
+const DEPENDENT: f64 = 1e-8;
+
+/// A linearization point and the modes built there.
+pub struct Basis {
+    /// Slot positions x* the modal coordinates are measured from.
+    pub point: Vec<f64>,
+    /// x* is the rest positions of the scene.
+    pub at_rest: bool,
+    pub pattern: StiffnessPattern,
+    /// Upper triangle of the stiffness K(x*).
+    pub stiffness: Vec<f64>,
+    pub modes: ModalBasis,
+}
+
+/// The load patterns the options rank and correct for: M g, when gravity
+/// is not zero, and the point load on its node, when it is not zero
+/// (`docs/method.md`, section 8). With `anchor_motion` the inertial load of
+/// an anchor acceleration along each axis, M e_i, takes the place of M g
+/// (whose span it holds). With `anchor_rotation` the inertial loads of the
+/// holder's angular acceleration and of its spin about each axis it can
+/// turn about (z alone in 2D) join them: M (e_i x s) and M (s - e_i (e_i . s)),
+/// s = x_rest - X0 about the pivot.
+pub fn load_patterns(scene: &Scene, loads: &Loads, anchor_motion: bool, anchor_rotation: bool) -> Vec<Vec<f64>> {
+    let d = scene.dim;
+    let g = &loads.gravity[..d];
+    let mut patterns = Vec::new();
+    if anchor_motion {
+        for i in 0..d {
+            patterns.push((0..scene.n_dofs()).map(|k| if k % d == i { scene.dof_mass[k] } else { 0.0 }).collect());
+        }
+    } else if g.iter().any(|&x| x != 0.0) {
+        patterns.push((0..scene.n_dofs()).map(|k| scene.dof_mass[k] * g[k % d]).collect());
+    }
+    if let Some((dof, f)) = loads.point_force(scene) {
+        let mut p = vec![0.0; scene.n_dofs()];
+        p[dof..dof + d].copy_from_slice(f);
+        patterns.push(p);
+    }
+    if anchor_rotation {
+        let pivot = scene.pivot();
+        let axes: &[usize] = if d == 2 { &[2] } else { &[0, 1, 2] };
+        for &axis in axes {
+            let e: [f64; 3] = std::array::from_fn(|i| if i == axis { 1.0 } else { 0.0 });
+            let (mut euler, mut spin) = (vec![0.0; scene.n_dofs()], vec![0.0; scene.n_dofs()]);
+            for k in 0..scene.n_free {
+                let s: [f64; 3] = std::array::from_fn(|i| if i < d { scene.rest[k * d + i] - pivot[i] } else { 0.0 });
+                let turned = cross(&e, &s);
+                for i in 0..d {
+                    let m = scene.dof_mass[k * d + i];
+                    euler[k * d + i] = m * turned[i];
+                    spin[k * d + i] = m * (s[i] - e[i] * s[axis]);
+                }
+            }
+            patterns.push(euler);
+            patterns.push(spin);
+        }
+    }
+    patterns
+}
+
+/// The external load on the free DOFs: M g plus the point load (`docs/method.md`, section 8).
+pub fn external_load(scene: &Scene, loads: &Loads) -> Vec<f64> {
+    let d = scene.dim;
+    let mut f: Vec<f64> = (0..scene.n_dofs()).map(|k| scene.dof_mass[k] * loads.gravity[k % d]).collect();
+    if let Some((dof, p)) = loads.point_force(scene) {
+        for (fk, pk) in f[dof..dof + d].iter_mut().zip(p) {
+            *fk += pk;
+        }
+    }
+    f
+}
+
+/// The linearization point x* `settings` ask for (rest, or the static
+/// equilibrium under the set-up loads), the stiffness pattern and the
+/// upper triangle of K(x*).
+pub fn linearize(scene: &Scene, loads: &Loads, settings: &Settings) -> Result<(Vec<f64>, StiffnessPattern, Vec<f64>), PhysicsError> {
+    let pattern = StiffnessPattern::new(scene);
+    let point = match settings.linearization {
+        Linearization::Rest => scene.rest.clone(),
+        Linearization::Equilibrium => equilibrium(scene, &pattern, &external_load(scene, loads))?,
+    };
+    let mut stiffness = vec![0.0; pattern.nnz()];
+    pattern.add_tangent(scene, &point, 1.0, &mut stiffness);
+    Ok((point, pattern, stiffness))
+}
+
+/// The vectors a static correction adds to a basis linearized at `point`:
+/// at rest the static responses K⁻¹ f to every load pattern; at the
+/// equilibrium the sag x* - x_rest itself (known exactly), and with the
+/// holder moving or turning the responses to its inertial loads through
+/// the tangent stiffness there.
+pub fn static_vectors(
+    scene: &Scene,
+    pattern: &StiffnessPattern,
+    stiffness: &[f64],
+    point: &[f64],
+    patterns: &[Vec<f64>],
+    settings: &Settings,
+) -> Result<Vec<Vec<f64>>, PhysicsError> {
+    let n = scene.n_dofs();
+    if settings.linearization == Linearization::Rest {
+        let solver = ShiftedStiffness::new(scene, pattern, stiffness)?;
+        return Ok(patterns.iter().map(|f| solver.solve(f)).collect());
+    }
+    let mut vectors = vec![(0..n).map(|k| point[k] - scene.rest[k]).collect::<Vec<f64>>()];
+    if settings.anchor_motion || settings.anchor_rotation {
+        let solver = ShiftedStiffness::new(scene, pattern, stiffness)?;
+        let translation = if settings.anchor_motion { scene.dim } else { 0 };
+        let rotation = if settings.anchor_rotation { 2 * if scene.dim == 2 { 1 } else { 3 } } else { 0 };
+        let inertial = patterns[..translation].iter().chain(&patterns[patterns.len() - rotation..]);
+        vectors.extend(inertial.map(|f| solver.solve(f)));
+    }
+    Ok(vectors)
+}
+
+/// The basis of `n_modes` vectors on `scene` under `loads`, chosen and
+/// linearized as `settings` ask (`mode_selection`, `static_correction`,
+/// `linearization`, `anchor_motion`). A trained basis comes from its
+/// training program ([`crate::physics::setup::trained_basis`]), not from here: where one is
+/// asked for only to report modal coordinates (full space), the lowest
+/// modes are reported.
+pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) -> Result<Basis, PhysicsError> {
+    let n = scene.n_dofs();
+    if n_modes > n {
+        return Err(PhysicsError::ModesExceedDofs { modes: n_modes, dofs: n });
+    }
+    let (point, pattern, stiffness) = linearize(scene, loads, settings)?;
+    let at_rest = settings.linearization == Linearization::Rest;
+    let patterns = load_patterns(scene, loads, settings.anchor_motion, settings.anchor_rotation);
+    let selection = match settings.mode_selection {
+        ModeSelection::Trained => ModeSelection::Lowest,
+        other => other,
+    };
+    let needs_load = selection == ModeSelection::Load || settings.static_correction;
+    if needs_load && patterns.is_empty() {
+        return Err(PhysicsError::NoLoad);
+    }
+    let plain = selection == ModeSelection::Lowest && !settings.static_correction;
+    let modes = if plain {
+        ModalBasis::lowest(scene, &pattern, &stiffness, n_modes)?
+    } else {
+        let statics = if settings.static_correction { patterns.len().min(n_modes) } else { 0 };
+        let eigen = n_modes - statics;
+        // Candidates in the order they are wanted; a few more than needed
+        // stand in for static responses the modes already hold.
+        let spare = if settings.static_correction { statics } else { 0 };
+        let candidates = match selection {
+            ModeSelection::Load => {
+                // Away from rest the run starts displaced from x* by x_rest - x*: its modal amplitudes count too.
+                let start: Option<Vec<f64>> = (!at_rest).then(|| (0..n).map(|k| scene.rest[k] - point[k]).collect());
+                ranked(scene, &pattern, &stiffness, &patterns, start.as_deref(), (eigen + spare).min(n))?
+            }
+            _ => ModalBasis::lowest(scene, &pattern, &stiffness, (eigen + spare).min(n))?,
+        };
+        let columns = |b: &ModalBasis, j: usize| -> Vec<f64> { (0..n).map(|i| b.phi[i * b.r + j]).collect() };
+        let mut vectors: Vec<Vec<f64>> = (0..eigen.min(candidates.r)).map(|j| columns(&candidates, j)).collect();
+        if settings.static_correction {
+            vectors.extend(static_vectors(scene, &pattern, &stiffness, &point, &patterns, settings)?);
+            vectors.extend((eigen..candidates.r).map(|j| columns(&candidates, j)));
+        }
+        orthonormal_ritz(scene, &pattern, &stiffness, &vectors, n_modes)?
+    };
+    Ok(Basis { point, at_rest, pattern, stiffness, modes })
+}
+
+/// The `r` modes with the largest amplitude in the static response to the
+/// load patterns, |φ_iᵀ f| / λ_i, or in the displacement `start` the run
+/// begins with, |φ_iᵀ M u₀|; ascending in frequency.
+fn ranked(
+    scene: &Scene,
+    pattern: &StiffnessPattern,
+    stiffness: &[f64],
+    patterns: &[Vec<f64>],
+    start: Option<&[f64]>,
+    r: usize,
+) -> Result<ModalBasis, PhysicsError> {
+    let n = scene.n_dofs();
+    let all = if n <= DENSE_CANDIDATES {
+        ModalBasis::dense(scene, pattern, stiffness, n)?
+    } else {
+        load_ritz(scene, pattern, stiffness, patterns, start, (RITZ_FACTOR * r).max(r + RITZ_EXTRA).min(n))?
+    };
+    let lambda_floor = 1e-12 * all.lambda.iter().fold(0.0f64, |m, l| m.max(*l)).max(f64::MIN_POSITIVE);
+    let share = |j: usize| -> f64 {
+        let loaded =
+            patterns.iter().map(|f| (0..n).map(|i| all.phi[i * all.r + j] * f[i]).sum::<f64>().abs() / all.lambda[j].max(lambda_floor)).fold(0.0, f64::max);
+        let started = start.map_or(0.0, |u| (0..n).map(|i| all.phi[i * all.r + j] * scene.dof_mass[i] * u[i]).sum::<f64>().abs());
+        loaded.max(started)
+    };
+    let mut order: Vec<(f64, usize)> = (0..all.r).map(|j| (share(j), j)).collect();
+    order.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    let mut keep: Vec<usize> = order.iter().take(r).map(|&(_, j)| j).collect();
+    keep.sort_unstable(); // ascending frequency, as the modes came
+    let mut phi = vec![0.0; n * keep.len()];
+    for i in 0..n {
+        for (c, &j) in keep.iter().enumerate() {
+            phi[i * keep.len() + c] = all.phi[i * all.r + j];
+        }
+    }
+    Ok(ModalBasis { n, r: keep.len(), lambda: keep.iter().map(|&j| all.lambda[j]).collect(), phi })
+}
+
+/// `m` Ritz pairs of the Krylov space of (K − σM)⁻¹ M grown from (K − σM)⁻¹ f
+/// for every load pattern f, and from the start displacement (σ a small
+/// negative shift, so the factor exists where K is singular).
+fn load_ritz(
+    scene: &Scene,
+    pattern: &StiffnessPattern,
+    stiffness: &[f64],
+    patterns: &[Vec<f64>],
+    start: Option<&[f64]>,
+    m: usize,
+) -> Result<ModalBasis, PhysicsError> {
+    let solver = ShiftedStiffness::new(scene, pattern, stiffness)?;
+    let mass = &scene.dof_mass;
+    let mut basis = MOrthonormal::new(mass, m);
+    let mut block: Vec<Vec<f64>> = patterns.iter().map(|f| solver.solve(f)).collect();
+    block.extend(start.map(|u| u.to_vec()));
+    while !basis.full() && !block.is_empty() {
+        let mut next = Vec::new();
+        for v in block {
+            if let Some(q) = basis.push(&v) {
+                let mq: Vec<f64> = q.iter().zip(mass).map(|(a, b)| a * b).collect();
+                next.push(solver.solve(&mq));
+                if basis.full() {
+                    break;
+                }
+            }
+        }
+        block = next;
+    }
+    rayleigh_ritz(pattern, stiffness, basis.columns())
+}
+
+/// An M-orthonormal set of columns grown one vector at a time: classical
+/// Gram-Schmidt against all columns so far, as faer's matrix-vector
+/// products Qᵀ (M v) and v − Q c, repeated once where the first pass left
+/// less than 1/√2 of the norm ("twice is enough", Kahan and Parlett).
+struct MOrthonormal<'a> {
+    mass: &'a [f64],
+    q: Mat<f64>,
+    k: usize,
+    /// Scratch: M v.
+    mv: Col<f64>,
+}
+
+impl<'a> MOrthonormal<'a> {
+    fn new(mass: &'a [f64], capacity: usize) -> Self {
+        MOrthonormal { mass, q: Mat::zeros(mass.len(), capacity), k: 0, mv: Col::zeros(mass.len()) }
+    }
+
+    fn len(&self) -> usize {
+        self.k
+    }
+
+    fn full(&self) -> bool {
+        self.k == self.q.ncols()
+    }
+
+    /// The columns so far.
+    fn columns(&self) -> MatRef<'_, f64> {
+        self.q.as_ref().subcols(0, self.k)
+    }
+
+    /// Adds what of `v` is M-orthogonal to the columns, M-normalized, and
+    /// returns it; `None` (nothing added) if the set is full or less than
+    /// [`DEPENDENT`] of `v`'s M-norm is left.
+    fn push(&mut self, v: &[f64]) -> Option<&[f64]> {
+        if self.full() {
+            return None;
+        }
+        let (n, k, mass) = (self.mass.len(), self.k, self.mass);
+        let m_norm = |x: &[f64]| x.iter().zip(mass).map(|(a, m)| m * a * a).sum::<f64>().sqrt();
+        let norm0 = m_norm(v);
+        if !(norm0 > 0.0 && norm0.is_finite()) {
+            return None;
+        }
+        let (done, mut rest) = self.q.as_mut().split_at_col_mut(k);
+        let mut x = rest.rb_mut().col_mut(0);
+        for (i, &vi) in v.iter().enumerate() {
+            x[i] = vi;
+        }
+        let mut norm = norm0;
+        if k > 0 {
+            let mut c = Col::<f64>::zeros(k);
+            for _ in 0..2 {
+                for i in 0..n {
+                    self.mv[i] = mass[i] * x[i];
+                }
+                matmul(c.as_mat_mut(), Accum::Replace, done.rb().transpose(), self.mv.as_mat(), 1.0, Par::Seq);
+                matmul(x.rb_mut().as_mat_mut(), Accum::Add, done.rb(), c.as_mat(), -1.0, Par::Seq);
+                let before = norm;
+                norm = m_norm(x.rb().try_as_col_major().expect("contiguous").as_slice());
+                if norm > std::f64::consts::FRAC_1_SQRT_2 * before {
+                    break;
+                }
+            }
+        }
+        if !(norm > DEPENDENT * norm0) {
+            return None;
+        }
+        x.try_as_col_major_mut().expect("contiguous").as_slice_mut().iter_mut().for_each(|a| *a /= norm);
+        self.k += 1;
+        Some(self.q.col(k).try_as_col_major().expect("contiguous").as_slice())
+    }
+}
+
+/// The first `r` independent directions of `vectors` (in their order),
+/// M-orthonormalized ([`MOrthonormal`]), then diagonalized in their span
+/// ([`rayleigh_ritz`]).
+pub fn orthonormal_ritz(scene: &Scene, pattern: &StiffnessPattern, stiffness: &[f64], vectors: &[Vec<f64>], r: usize) -> Result<ModalBasis, PhysicsError> {
+    let mut q = MOrthonormal::new(&scene.dof_mass, r);
+    for v in vectors {
+        if q.full() {
+            break;
+        }
+        q.push(v);
+    }
+    if q.len() < r {
+        return Err(PhysicsError::BasisDeficient { wanted: r, found: q.len() });
+    }
+    rayleigh_ritz(pattern, stiffness, q.columns())
+}
+
+/// The M-orthonormal columns Q (n x r) diagonalized in their span: Φ = Q Z
+/// with Zᵀ (Qᵀ K Q) Z = diag(λ), Zᵀ Z = I. K Q column by column, the two
+/// dense products Qᵀ (K Q) and Q Z by faer, and faer's self-adjoint eigen
+/// decomposition of the r x r matrix.
+fn rayleigh_ritz(pattern: &StiffnessPattern, stiffness: &[f64], q: MatRef<'_, f64>) -> Result<ModalBasis, PhysicsError> {
+    let (n, r) = (q.nrows(), q.ncols());
+    let mut kq = Mat::<f64>::zeros(n, r);
+    for j in 0..r {
+        let x = q.col(j).try_as_col_major().expect("contiguous").as_slice();
+        pattern.sym_matvec(stiffness, x, kq.col_mut(j).try_as_col_major_mut().expect("contiguous").as_slice_mut());
+    }
+    let mut kr = Mat::<f64>::zeros(r, r);
+    matmul(kr.as_mut(), Accum::Replace, q.transpose(), kq.as_ref(), 1.0, Par::Seq);
+    drop(kq);
+    // Symmetrize the round-off away before the symmetric solver reads one triangle.
+    for j in 0..r {
+        for i in 0..j {
+            let s = 0.5 * (kr[(i, j)] + kr[(j, i)]);
+            kr[(i, j)] = s;
+            kr[(j, i)] = s;
+        }
+    }
+    let evd =
+        kr.self_adjoint_eigen(Side::Lower).map_err(|e| PhysicsError::LinearAlgebra { what: "Rayleigh-Ritz eigen decomposition", detail: format!("{e:?}") })?;
+    let (s, z) = (evd.S(), evd.U());
+    let lambda_max = (0..r).fold(0.0f64, |m, j| m.max(s[j].abs()));
+    let mut lambda = Vec::with_capacity(r);
+    for j in 0..r {
+        let l = s[j];
+        // Round-off around a zero eigenvalue may come out slightly negative.
+        let l = if l < 0.0 && l.abs() <= 1e-10 * lambda_max { 0.0 } else { l };
+        if !(l >= 0.0) {
+            return Err(PhysicsError::NegativeEigenvalue { lambda: l });
+        }
+        lambda.push(l);
+    }
+    // Φ row-major (n x r) is Φᵀ = Zᵀ Qᵀ column-major (r x n).
+    let mut phi = vec![0.0; n * r];
+    matmul(MatMut::from_column_major_slice_mut(&mut phi, r, n), Accum::Replace, z.transpose(), q.transpose(), 1.0, Par::Seq);
+    Ok(ModalBasis { n, r, lambda, phi })
+}
+
+/// Solves with K − σM, σ a small negative shift (so a singular K factors;
+/// the solution differs from K⁺f by a relative σ/λ_min).
+struct ShiftedStiffness {
+    llt: faer::sparse::linalg::solvers::Llt<usize, f64>,
+}
+
+impl ShiftedStiffness {
+    fn new(scene: &Scene, pattern: &StiffnessPattern, stiffness: &[f64]) -> Result<Self, PhysicsError> {
+        let n = scene.n_dofs();
+        let diag_max = pattern.diag.iter().enumerate().fold(0.0f64, |m, (k, &p)| m.max(stiffness[p] / scene.dof_mass[k]));
+        let sigma = -1e-9 * diag_max;
+        let mut vals = stiffness.to_vec();
+        for (k, &p) in pattern.diag.iter().enumerate() {
+            vals[p] -= sigma * scene.dof_mass[k];
+        }
+        let sym = SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx);
+        let llt = SparseColMatRef::new(sym, &vals)
+            .sp_cholesky(Side::Upper)
+            .map_err(|e| PhysicsError::LinearAlgebra { what: "sparse Cholesky factorization of the stiffness", detail: format!("{e:?}") })?;
+        Ok(ShiftedStiffness { llt })
+    }
+
+    fn solve(&self, f: &[f64]) -> Vec<f64> {
+        let mut x = faer::Col::<f64>::from_fn(f.len(), |i| f[i]);
+        faer::linalg::solvers::Solve::solve_in_place(&self.llt, x.as_mat_mut());
+        x.iter().copied().collect()
+    }
+}
