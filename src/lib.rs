@@ -8,6 +8,7 @@
 //! the canonical scenes of that table to the study, benchmarks and tests.
 //! `docs/method.md` is the method, `docs/architecture.md` the shape of the code.
 
+pub mod bytes;
 pub mod fmi;
 pub mod measures;
 pub mod model;

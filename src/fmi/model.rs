@@ -9,7 +9,7 @@ use std::path::Path;
 
 use super::logging::Logger;
 use super::params::Params;
-use super::serialize::Reader;
+use crate::bytes::Reader;
 
 /// Value of a variable that the model computes (an output, a calculated parameter).
 pub enum Computed<'a> {

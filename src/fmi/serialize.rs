@@ -14,6 +14,8 @@
 
 use fmi_sys::fmi3::{fmi3FMUState, fmi3Status};
 
+use crate::bytes::{put_f64, put_f64s, put_u32, put_u64, Reader};
+
 use super::fmu_state::FmuState;
 use super::instance::Instance;
 use super::model::Model;
@@ -73,7 +75,7 @@ pub fn payload(s: &FmuState) -> Vec<u8> {
     let params: Vec<usize> = (0..VARIABLES.len()).filter(|&i| VARIABLES[i].holds_value()).collect();
     put_u64(&mut p, params.len() as u64);
     for i in params {
-        p.extend_from_slice(&VARIABLES[i].vr.to_le_bytes());
+        put_u32(&mut p, VARIABLES[i].vr);
         put_f64s(&mut p, &s.params.values[i]);
     }
     match &s.snapshot {
@@ -115,7 +117,7 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
     if checksum(body) != u32::from_le_bytes(tail.try_into().unwrap()) {
         return Err("CRC-32 mismatch: the serialized state is corrupted".into());
     }
-    let mut r = Reader { b: &body[HEADER..] };
+    let mut r = Reader::new(&body[HEADER..]);
     let mode = Mode::from_u8(r.u8()?).ok_or("bad mode")?;
     let start_time = r.f64()?;
     if !start_time.is_finite() {
@@ -168,8 +170,8 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
         1 => Some(TheModel::read_snapshot(&mut r)?),
         _ => return Err("bad snapshot flag".into()),
     };
-    if !r.b.is_empty() {
-        return Err(format!("{} unexpected bytes at the end", r.b.len()));
+    if !r.is_done() {
+        return Err(format!("{} unexpected bytes at the end", r.remaining()));
     }
     if matches!(mode, Mode::StepMode | Mode::Terminated) && snapshot.is_none() {
         return Err("a state after initialization must hold the simulator state".into());
@@ -181,53 +183,6 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
         return Err("a state before initialization has no stop time".into());
     }
     Ok(FmuState::new(mode, start_time, stop_time, params, snapshot))
-}
-
-pub fn put_u64(v: &mut Vec<u8>, x: u64) {
-    v.extend_from_slice(&x.to_le_bytes());
-}
-pub fn put_f64(v: &mut Vec<u8>, x: f64) {
-    v.extend_from_slice(&x.to_le_bytes());
-}
-pub fn put_f64s(v: &mut Vec<u8>, x: &[f64]) {
-    put_u64(v, x.len() as u64);
-    x.iter().for_each(|x| put_f64(v, *x));
-}
-
-/// Reads a payload front to back; every read checks the bytes left.
-pub struct Reader<'a> {
-    b: &'a [u8],
-}
-
-impl Reader<'_> {
-    fn take(&mut self, n: usize) -> Result<&[u8], String> {
-        if self.b.len() < n {
-            return Err("truncated serialized state".into());
-        }
-        let (a, rest) = self.b.split_at(n);
-        self.b = rest;
-        Ok(a)
-    }
-    pub fn u8(&mut self) -> Result<u8, String> {
-        Ok(self.take(1)?[0])
-    }
-    pub fn u32(&mut self) -> Result<u32, String> {
-        Ok(u32::from_le_bytes(self.take(4)?.try_into().unwrap()))
-    }
-    pub fn u64(&mut self) -> Result<u64, String> {
-        Ok(u64::from_le_bytes(self.take(8)?.try_into().unwrap()))
-    }
-    pub fn f64(&mut self) -> Result<f64, String> {
-        Ok(f64::from_le_bytes(self.take(8)?.try_into().unwrap()))
-    }
-    /// Length-prefixed; the length is checked against the bytes left before allocating.
-    pub fn f64s(&mut self) -> Result<Vec<f64>, String> {
-        let n = self.u64()?;
-        if n > (self.b.len() / 8) as u64 {
-            return Err("truncated serialized state".into());
-        }
-        (0..n).map(|_| self.f64()).collect()
-    }
 }
 
 impl Instance {

@@ -14,6 +14,7 @@
 //! count, f64 bits), the data (u64 length + [`SetupData::to_bytes`]), and a
 //! CRC-32 of everything before it.
 
+use crate::bytes::{put_f64, put_u32, put_u64, Reader, Truncated};
 use crate::fmi::params::Params;
 use crate::fmi::variables::{vr, Variability, VARIABLES};
 use crate::physics::{SetupData, Simulator};
@@ -44,16 +45,16 @@ pub fn write(p: &Params, sim: &Simulator) -> Option<Vec<u8>> {
     let mut b = Vec::new();
     b.extend_from_slice(MAGIC);
     let version = env!("CARGO_PKG_VERSION").as_bytes();
-    b.extend_from_slice(&(version.len() as u32).to_le_bytes());
+    put_u32(&mut b, version.len() as u32);
     b.extend_from_slice(version);
     let key = key(p);
-    b.extend_from_slice(&(key.len() as u32).to_le_bytes());
-    for (r, values) in &key {
-        b.extend_from_slice(&r.to_le_bytes());
-        b.extend_from_slice(&(values.len() as u32).to_le_bytes());
-        values.iter().for_each(|x| b.extend_from_slice(&x.to_bits().to_le_bytes()));
+    put_u32(&mut b, key.len() as u32);
+    for (vr, values) in &key {
+        put_u32(&mut b, *vr);
+        put_u32(&mut b, values.len() as u32);
+        values.iter().for_each(|x| put_f64(&mut b, *x));
     }
-    b.extend_from_slice(&(data.len() as u64).to_le_bytes());
+    put_u64(&mut b, data.len() as u64);
     b.extend_from_slice(&data);
     let crc = crc32fast::hash(&b);
     b.extend_from_slice(&crc.to_le_bytes());
@@ -70,29 +71,23 @@ pub fn read(bytes: &[u8], p: &Params) -> Result<SetupData, String> {
     if crc32fast::hash(body).to_le_bytes() != crc {
         return Err(corrupt());
     }
-    let mut at = MAGIC.len();
-    let mut take = |n: usize| -> Result<&[u8], String> {
-        let s = body.get(at..at.checked_add(n).ok_or_else(corrupt)?).ok_or_else(corrupt)?;
-        at += n;
-        Ok(s)
-    };
-    let u32_of = |s: &[u8]| u32::from_le_bytes(s.try_into().unwrap()) as usize;
-    let n = u32_of(take(4)?);
-    let version = take(n)?;
+    let corrupted = |_: Truncated| corrupt();
+    let mut r = Reader::new(&body[MAGIC.len()..]);
+    let n = r.u32().map_err(corrupted)? as usize;
+    let version = r.take(n).map_err(corrupted)?;
     if version != env!("CARGO_PKG_VERSION").as_bytes() {
         return Err(format!("it was baked by version {} of the FMU, this is {}", String::from_utf8_lossy(version), env!("CARGO_PKG_VERSION")));
     }
-    let count = u32_of(take(4)?);
+    let count = r.u32().map_err(corrupted)? as usize;
     let mut stored = Vec::with_capacity(count.min(VARIABLES.len()));
     for _ in 0..count {
-        let r = u32_of(take(4)?) as u32;
-        let n = u32_of(take(4)?);
-        let raw = take(n.checked_mul(8).ok_or_else(corrupt)?)?;
-        stored.push((r, raw.chunks_exact(8).map(|c| f64::from_bits(u64::from_le_bytes(c.try_into().unwrap()))).collect::<Vec<f64>>()));
+        let vr = r.u32().map_err(corrupted)?;
+        let n = r.u32().map_err(corrupted)? as usize;
+        stored.push((vr, r.f64s_of(n).map_err(corrupted)?));
     }
-    for (r, values) in key(p) {
-        let name = VARIABLES.iter().find(|v| v.vr == r).map_or("?", |v| v.name);
-        match stored.iter().find(|(s, _)| *s == r) {
+    for (vr, values) in key(p) {
+        let name = VARIABLES.iter().find(|v| v.vr == vr).map_or("?", |v| v.name);
+        match stored.iter().find(|(s, _)| *s == vr) {
             Some((_, baked)) if *baked == values => {}
             Some((_, baked)) => return Err(format!("it was baked for {name} = {}, the instance has {}", show(baked), show(&values))),
             None => return Err(format!("it holds no value of {name}")),
@@ -101,9 +96,9 @@ pub fn read(bytes: &[u8], p: &Params) -> Result<SetupData, String> {
     if stored.len() != key(p).len() {
         return Err("it was baked for other parameters".into());
     }
-    let len = u64::from_le_bytes(take(8)?.try_into().unwrap()) as usize;
-    let data = take(len)?;
-    if at != body.len() {
+    let len = usize::try_from(r.u64().map_err(corrupted)?).map_err(|_| corrupt())?;
+    let data = r.take(len).map_err(corrupted)?;
+    if !r.is_done() {
         return Err(corrupt());
     }
     SetupData::from_bytes(data).ok_or_else(corrupt)

@@ -19,9 +19,9 @@ mod snapshot;
 
 use std::path::Path;
 
+use crate::bytes::Reader;
 use crate::fmi::logging::Logger;
 use crate::fmi::model::{Computed, Model, StepEnd};
-use crate::fmi::serialize::Reader;
 use crate::fmi::variables::{index_of, vr, Causality, VARIABLES};
 use crate::fmi::{OK, WARNING};
 use crate::physics::{Loads, ModeClasses, Simulator, Snapshot};

@@ -4,7 +4,7 @@
 //! anchor and holder targets, damping,
 //! weights.
 
-use crate::fmi::serialize::{put_f64, put_f64s, put_u64, Reader};
+use crate::bytes::{put_f64, put_f64s, put_u64, Reader};
 use crate::physics::{Loads, Snapshot, State};
 
 pub fn write(snap: &Snapshot, p: &mut Vec<u8>) {

@@ -9,6 +9,7 @@
 //! [`SetupData::from_bytes`] refuses anything that does not parse to the
 //! end. Which parameters it belongs to is the caller's business.
 
+use crate::bytes::{put_f64s, put_u32, put_u64, put_u8, Reader};
 use crate::physics::setup::modes::ModalBasis;
 
 /// The cubature set: scene indices of the kept springs and their weights.
@@ -76,33 +77,29 @@ impl SetupData {
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut b = Vec::new();
         b.extend_from_slice(MAGIC);
-        b.extend_from_slice(&FORMAT.to_le_bytes());
-        let words = |b: &mut Vec<u8>, v: &[f64]| {
-            b.extend_from_slice(&(v.len() as u64).to_le_bytes());
-            v.iter().for_each(|x| b.extend_from_slice(&x.to_bits().to_le_bytes()));
-        };
-        b.extend_from_slice(&(self.basis.n as u64).to_le_bytes());
-        b.extend_from_slice(&(self.basis.r as u64).to_le_bytes());
-        words(&mut b, &self.basis.lambda);
-        words(&mut b, &self.basis.phi);
-        words(&mut b, &self.point);
-        b.push(self.at_rest as u8);
-        words(&mut b, &[self.omega_sq_bound]);
+        put_u32(&mut b, FORMAT);
+        put_u64(&mut b, self.basis.n as u64);
+        put_u64(&mut b, self.basis.r as u64);
+        put_f64s(&mut b, &self.basis.lambda);
+        put_f64s(&mut b, &self.basis.phi);
+        put_f64s(&mut b, &self.point);
+        put_u8(&mut b, self.at_rest as u8);
+        put_f64s(&mut b, &[self.omega_sq_bound]);
         match &self.cubature {
-            None => b.push(0),
+            None => put_u8(&mut b, 0),
             Some(c) => {
-                b.push(1);
-                words(&mut b, &c.springs.iter().map(|&s| s as f64).collect::<Vec<_>>());
-                words(&mut b, &c.weights);
-                words(&mut b, &[c.training_error, c.held_out_error]);
+                put_u8(&mut b, 1);
+                put_f64s(&mut b, &c.springs.iter().map(|&s| s as f64).collect::<Vec<_>>());
+                put_f64s(&mut b, &c.weights);
+                put_f64s(&mut b, &[c.training_error, c.held_out_error]);
             }
         }
         match &self.range {
-            None => b.push(0),
+            None => put_u8(&mut b, 0),
             Some(t) => {
-                b.push(1);
-                words(&mut b, &t.center);
-                words(&mut b, &t.half_width);
+                put_u8(&mut b, 1);
+                put_f64s(&mut b, &t.center);
+                put_f64s(&mut b, &t.half_width);
             }
         }
         b
@@ -110,29 +107,29 @@ impl SetupData {
 
     /// Parses [`Self::to_bytes`]; `None` if the bytes are not exactly that.
     pub fn from_bytes(bytes: &[u8]) -> Option<SetupData> {
-        let mut r = Reader { bytes, at: 0 };
-        if r.take(8)? != MAGIC || u32::from_le_bytes(r.take(4)?.try_into().ok()?) != FORMAT {
+        let mut r = Reader::new(bytes);
+        if r.take(8).ok()? != MAGIC || r.u32().ok()? != FORMAT {
             return None;
         }
-        let (n, rr) = (r.u64()? as usize, r.u64()? as usize);
-        let lambda = r.words()?;
-        let phi = r.words()?;
-        let point = r.words()?;
-        let at_rest = match r.take(1)?[0] {
+        let (n, rr) = (r.u64().ok()? as usize, r.u64().ok()? as usize);
+        let lambda = r.f64s().ok()?;
+        let phi = r.f64s().ok()?;
+        let point = r.f64s().ok()?;
+        let at_rest = match r.u8().ok()? {
             0 => false,
             1 => true,
             _ => return None,
         };
-        let omega_sq_bound = *r.words()?.first()?;
-        let cubature = match r.take(1)?[0] {
+        let omega_sq_bound = *r.f64s().ok()?.first()?;
+        let cubature = match r.u8().ok()? {
             0 => None,
             1 => {
-                let springs = r.words()?;
+                let springs = r.f64s().ok()?;
                 if !springs.iter().all(|s| s.fract() == 0.0 && *s >= 0.0 && *s < 1e15) {
                     return None;
                 }
-                let weights = r.words()?;
-                let errors = r.words()?;
+                let weights = r.f64s().ok()?;
+                let errors = r.f64s().ok()?;
                 Some(SpringSet {
                     springs: springs.iter().map(|&s| s as usize).collect(),
                     weights,
@@ -142,10 +139,10 @@ impl SetupData {
             }
             _ => return None,
         };
-        let range = match r.take(1)?[0] {
+        let range = match r.u8().ok()? {
             0 => None,
             1 => {
-                let (center, half_width) = (r.words()?, r.words()?);
+                let (center, half_width) = (r.f64s().ok()?, r.f64s().ok()?);
                 if center.len() != rr
                     || half_width.len() != rr
                     || !center.iter().all(|c| c.is_finite())
@@ -157,31 +154,9 @@ impl SetupData {
             }
             _ => return None,
         };
-        if r.at != bytes.len() || lambda.len() != rr || phi.len() != n.checked_mul(rr)? {
+        if !r.is_done() || lambda.len() != rr || phi.len() != n.checked_mul(rr)? {
             return None;
         }
         Some(SetupData { basis: ModalBasis { n, r: rr, lambda, phi }, point, at_rest, omega_sq_bound, cubature, range })
-    }
-}
-
-struct Reader<'a> {
-    bytes: &'a [u8],
-    at: usize,
-}
-
-impl<'a> Reader<'a> {
-    fn take(&mut self, n: usize) -> Option<&'a [u8]> {
-        let end = self.at.checked_add(n)?;
-        let s = self.bytes.get(self.at..end)?;
-        self.at = end;
-        Some(s)
-    }
-    fn u64(&mut self) -> Option<u64> {
-        Some(u64::from_le_bytes(self.take(8)?.try_into().ok()?))
-    }
-    fn words(&mut self) -> Option<Vec<f64>> {
-        let n = self.u64()? as usize;
-        let raw = self.take(n.checked_mul(8)?)?;
-        Some(raw.chunks_exact(8).map(|c| f64::from_bits(u64::from_le_bytes(c.try_into().unwrap()))).collect())
     }
 }
