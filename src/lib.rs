@@ -15,3 +15,8 @@ pub mod model;
 pub mod options;
 pub mod physics;
 pub mod scenes;
+pub mod status;
+
+/// The model this FMU exports: the one place the generic FMI layer is bound
+/// to it (the Reference FMUs' `config.h`), outside the layer itself.
+pub type TheModel = model::MassSpring;

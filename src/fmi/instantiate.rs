@@ -12,8 +12,9 @@ use super::functions::Function;
 use super::instance::Instance;
 use super::logging::log_raw;
 use super::params::Params;
+use super::registry;
 use super::variables::INSTANTIATION_TOKEN;
-use super::{registry, ERROR, FATAL, OK};
+use crate::status::{ERROR, FATAL, OK};
 
 /// Keeps this library in memory for the rest of the process, once: a host
 /// that closes it (dlclose) and opens it again while instances live (Ecos

@@ -6,8 +6,9 @@ use std::ffi::{CStr, CString};
 
 use fmi_sys::fmi3::*;
 
+use super::ptr;
 use super::variables::LOG_CATEGORIES;
-use super::{ptr, DISCARD, ERROR, OK, WARNING};
+use crate::status::{DISCARD, ERROR, OK, WARNING};
 
 /// The host's callback and the categories it switched on.
 pub struct Logger {

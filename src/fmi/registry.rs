@@ -8,10 +8,7 @@ use std::sync::{Mutex, MutexGuard};
 
 use fmi_sys::fmi3::fmi3Instance;
 
-use super::instance::Instance;
-
-/// Checked on every call.
-pub const INSTANCE_MAGIC: u64 = 0x4d4d_535f_494e_5354;
+use super::instance::{Instance, INSTANCE_MAGIC};
 
 static LIVE: Mutex<BTreeSet<usize>> = Mutex::new(BTreeSet::new());
 

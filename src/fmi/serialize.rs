@@ -12,21 +12,15 @@
 //! Decoding checks all of it and every value against the model description,
 //! so a corrupted or foreign blob is refused instead of loaded.
 
-use fmi_sys::fmi3::{fmi3FMUState, fmi3Status};
-
 use crate::bytes::{put_f64, put_f64s, put_u32, put_u64, Reader};
 
 use super::fmu_state::FmuState;
-use super::instance::Instance;
 use super::model::Model;
 use super::params::Params;
-use super::ptr::{slice, too_many};
 use super::state_machine::Mode;
 use super::values::check_value;
 use super::variables::{index_of, LAYOUT_FINGERPRINT, VARIABLES};
-use super::{TheModel, OK};
-
-type R = Result<fmi3Status, fmi3Status>;
+use crate::TheModel;
 
 pub const MAGIC: &[u8; 8] = b"MMSFMU3S";
 /// 1: FNV-1a checksum, no stop time; 2: CRC-32, stop time; 3: the
@@ -183,61 +177,4 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
         return Err("a state before initialization has no stop time".into());
     }
     Ok(FmuState::new(mode, start_time, stop_time, params, snapshot))
-}
-
-impl Instance {
-    /// fmi3SerializedFMUStateSize.
-    ///
-    /// # Safety
-    /// `size` must be NULL or writable.
-    pub unsafe fn serialized_size(&self, state: fmi3FMUState, size: *mut usize) -> R {
-        const F: &str = "fmi3SerializedFMUStateSize";
-        if size.is_null() {
-            return Err(self.log.fail(&format!("{F}: size is NULL")));
-        }
-        let s = self.state_from_ptr(F, state)?;
-        *size = encode(s).len();
-        Ok(OK)
-    }
-
-    /// fmi3SerializeFMUState: exactly the size fmi3SerializedFMUStateSize gave.
-    ///
-    /// # Safety
-    /// `out` must be NULL or point to `size` writable bytes.
-    pub unsafe fn serialize(&self, state: fmi3FMUState, out: *mut u8, size: usize) -> R {
-        const F: &str = "fmi3SerializeFMUState";
-        let s = self.state_from_ptr(F, state)?;
-        let bytes = encode(s);
-        if out.is_null() {
-            return Err(self.log.fail(&format!("{F}: serializedState is NULL")));
-        }
-        if size != bytes.len() {
-            return Err(self.log.fail(&format!("{F}: size is {size}, fmi3SerializedFMUStateSize gave {}", bytes.len())));
-        }
-        std::ptr::copy_nonoverlapping(bytes.as_ptr(), out, size);
-        Ok(OK)
-    }
-
-    /// fmi3DeserializeFMUState: a state of an instance with the same
-    /// structural parameters, checked through and through before it is kept.
-    ///
-    /// # Safety
-    /// `bytes` must be NULL or point to `size` readable bytes; `out` NULL or a
-    /// readable and writable state pointer.
-    pub unsafe fn deserialize(&mut self, bytes: *const u8, size: usize, out: *mut fmi3FMUState) -> R {
-        const F: &str = "fmi3DeserializeFMUState";
-        if bytes.is_null() || out.is_null() {
-            return Err(self.log.fail(&format!("{F}: serializedState or FMUState is NULL")));
-        }
-        if too_many::<u8>(size) {
-            return Err(self.log.fail(&format!("{F}: size = {size} cannot be an array size")));
-        }
-        let s = decode(slice(bytes, size)).map_err(|m| self.log.fail(&format!("{F}: {m}")))?;
-        let mine = self.structural();
-        let theirs: Vec<_> = mine.iter().map(|(n, _)| (*n, s.params.values[VARIABLES.iter().position(|v| v.name == *n).unwrap()][0])).collect();
-        if mine != theirs {
-            return Err(self.log.fail(&format!("{F}: the state is from an instance with structural parameters {theirs:?}, this one has {mine:?}")));
-        }
-        self.store_state(F, out, s)
-    }
 }

@@ -1,12 +1,7 @@
 //! The FMI 3.0 Co-Simulation state machine this FMU implements (no Event
 //! Mode, no intermediate update, no clocks): its states, and the calls that
 //! move an instance between them. Which function is legal in which state is
-//! [`super::functions`]'s table; the check is in [`Instance::guard`].
-
-use super::functions::Function;
-use super::instance::Instance;
-use super::model::Model;
-use super::OK;
+//! [`super::functions`]'s table; the check is in `Instance::guard` (`instance/transitions.rs`).
 
 /// States an instance can be in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -49,72 +44,4 @@ pub mod mask {
 /// times accumulated differently by the importer).
 pub fn same_time(a: f64, b: f64) -> bool {
     (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0)
-}
-
-type R = Result<fmi3Status, fmi3Status>;
-use fmi_sys::fmi3::fmi3Status;
-
-impl Instance {
-    /// Refuses `f` unless the table allows it in the current state,
-    /// logging why: the one place where states are checked.
-    pub fn guard(&self, f: Function) -> Result<(), fmi3Status> {
-        let legal = f.legal();
-        if legal.states & self.mode.bit() != 0 {
-            return Ok(());
-        }
-        if legal.states == mask::NONE {
-            return Err(self.log.fail(&format!("{}: {}", f.name(), legal.note)));
-        }
-        let allowed: Vec<String> = Mode::ALL.iter().filter(|m| legal.states & m.bit() != 0).map(|m| format!("{m:?}")).collect();
-        let note = if legal.note.is_empty() { String::new() } else { format!(" ({})", legal.note) };
-        Err(self.log.fail(&format!("{}: illegal call sequence: not allowed in {:?}, only in {}{note}", f.name(), self.mode, allowed.join(", "))))
-    }
-
-    pub fn enter_initialization_mode(&mut self, start_time: f64, stop_time: Option<f64>) -> R {
-        const F: &str = "fmi3EnterInitializationMode";
-        if !start_time.is_finite() {
-            return Err(self.log.fail(&format!("{F}: startTime must be finite, got {start_time}")));
-        }
-        if let Some(stop) = stop_time {
-            if stop.is_nan() || stop < start_time {
-                return Err(self.log.fail(&format!("{F}: stopTime {stop} is before startTime {start_time}")));
-            }
-        }
-        self.start_time = start_time;
-        self.stop_time = stop_time;
-        self.mode = Mode::InitializationMode;
-        Ok(OK)
-    }
-
-    pub fn exit_initialization_mode(&mut self) -> R {
-        self.ensure_set_up()?;
-        self.mode = Mode::StepMode;
-        self.log.log(OK, "Step Mode");
-        Ok(OK)
-    }
-
-    pub fn enter_configuration_mode(&mut self) -> R {
-        self.mode = Mode::ConfigurationMode;
-        Ok(OK)
-    }
-
-    pub fn exit_configuration_mode(&mut self) -> R {
-        self.mode = Mode::Instantiated;
-        Ok(OK)
-    }
-
-    pub fn terminate(&mut self) -> R {
-        self.mode = Mode::Terminated;
-        Ok(OK)
-    }
-
-    /// Back to Instantiated with the start values.
-    pub fn reset(&mut self) -> R {
-        self.mode = Mode::Instantiated;
-        self.params = self.start.clone();
-        self.model.reset();
-        self.start_time = 0.0;
-        self.stop_time = None;
-        Ok(OK)
-    }
 }

@@ -23,8 +23,8 @@ use crate::bytes::Reader;
 use crate::fmi::logging::Logger;
 use crate::fmi::model::{Computed, Model, StepEnd};
 use crate::fmi::variables::{index_of, vr, Causality, VARIABLES};
-use crate::fmi::{OK, WARNING};
 use crate::physics::{Loads, ModeClasses, Simulator, Snapshot};
+use crate::status::{OK, WARNING};
 
 pub use crate::fmi::params::Params;
 

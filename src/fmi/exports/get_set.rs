@@ -4,8 +4,8 @@
 
 use fmi_sys::fmi3::*;
 
-use super::call;
 use crate::fmi::functions::Function as F;
+use crate::fmi::guard::call;
 use crate::fmi::variables::Type;
 
 #[no_mangle]

@@ -4,9 +4,8 @@
 
 use fmi_sys::fmi3::*;
 
-use super::call;
-use super::refuse;
 use crate::fmi::functions::Function as F;
+use crate::fmi::guard::{call, refuse};
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3EnterContinuousTimeMode(instance: fmi3Instance) -> fmi3Status {

@@ -8,9 +8,8 @@ use std::panic::catch_unwind;
 
 use fmi_sys::fmi3::*;
 
-use super::call;
-use super::refuse;
 use crate::fmi::functions::Function as F;
+use crate::fmi::guard::{call, refuse};
 use crate::fmi::instantiate;
 use crate::fmi::registry;
 

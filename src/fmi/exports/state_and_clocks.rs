@@ -6,9 +6,8 @@
 
 use fmi_sys::fmi3::*;
 
-use super::call;
-use super::refuse;
 use crate::fmi::functions::Function as F;
+use crate::fmi::guard::{call, refuse};
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3GetNumberOfVariableDependencies(instance: fmi3Instance, _a: fmi3ValueReference, _b: *mut usize) -> fmi3Status {

@@ -1,26 +1,37 @@
-//! One FMU instance: what it holds, its model set up on demand from the
-//! parameter values, and the communication step. The other jobs on an
-//! instance live in their own modules: states and transitions in
-//! [`super::state_machine`], Get/Set in [`super::values`], FMU states in
-//! [`super::fmu_state`], messages in [`super::logging`].
+//! One FMU instance, in one place: what it holds, its model set up on
+//! demand from the parameter values, and the communication step (here);
+//! the transitions between states and the guard (`transitions.rs`),
+//! Get/Set (`get_set.rs`) and FMU states (`fmu_states.rs`). The pieces
+//! they use (the state machine's states, the range checks, the byte
+//! format, the logger) live beside this folder and know nothing of an
+//! instance; the registry of live instances imports this one, not the
+//! other way round.
 
 use std::path::Path;
 
 use fmi_sys::fmi3::*;
 
-use super::fmu_state::OwnedStates;
-use super::logging::Logger;
-use super::model::{Model, StepEnd};
-use super::params::Params;
-use super::registry::INSTANCE_MAGIC;
-use super::state_machine::{same_time, Mode};
-use super::variables::{Causality, VARIABLES};
-use super::{TheModel, DISCARD, OK, WARNING};
+mod fmu_states;
+mod get_set;
+mod transitions;
 
+use crate::fmi::fmu_state::OwnedStates;
+use crate::fmi::logging::Logger;
+use crate::fmi::model::{Model, StepEnd};
+use crate::fmi::params::Params;
+use crate::fmi::state_machine::{same_time, Mode};
+use crate::fmi::variables::{Causality, VARIABLES};
+use crate::status::{DISCARD, OK, WARNING};
+use crate::TheModel;
+
+/// What a call on an instance returns: its status, or the status of its refusal.
 type R = Result<fmi3Status, fmi3Status>;
 
+/// Carried by every live instance and checked on every call (see [`crate::fmi::registry`]).
+pub const INSTANCE_MAGIC: u64 = 0x4d4d_535f_494e_5354;
+
 pub struct Instance {
-    pub(super) magic: u64,
+    pub(crate) magic: u64,
     pub log: Logger,
     pub mode: Mode,
     /// Set after a panic: the instance may be inconsistent and only accepts FreeInstance.
@@ -29,15 +40,15 @@ pub struct Instance {
     pub params: Params,
     /// The values before the Set in progress, kept in place so that a Set
     /// that is refused restores them without allocating.
-    pub(super) before_set: Params,
+    pub(crate) before_set: Params,
     /// Values restored by fmi3Reset: compiled start values or the FMU's resources/startValues.txt.
-    pub(super) start: Params,
+    pub(crate) start: Params,
     /// The model: its set-up, state and rules.
-    pub(super) model: TheModel,
-    pub(super) start_time: f64,
-    pub(super) stop_time: Option<f64>,
+    pub(crate) model: TheModel,
+    pub(crate) start_time: f64,
+    pub(crate) stop_time: Option<f64>,
     /// FMU states made by this instance and not freed yet.
-    pub(super) states: OwnedStates,
+    pub(crate) states: OwnedStates,
 }
 
 impl Instance {
@@ -58,7 +69,7 @@ impl Instance {
     }
 
     /// Sets the model up if parameters changed since the last set-up.
-    pub(super) fn ensure_set_up(&mut self) -> R {
+    pub(crate) fn ensure_set_up(&mut self) -> R {
         if !self.model.is_set_up() {
             if let Err(m) = self.model.set_up(&self.params, &self.log) {
                 return Err(self.log.fail(&m));

@@ -1,6 +1,8 @@
-//! The physics core has no import cycles and knows nothing of FMI.
+//! The physics core and the FMI glue have no import cycles; the physics
+//! knows nothing of FMI, and the glue names its model only through
+//! `crate::TheModel` (bound in `lib.rs`).
 //!
-//! Every file under `src/physics/` is a module; a module depends on every
+//! Every file under `src/physics/` (and `src/fmi/`) is a module; a module depends on every
 //! module a path in its code names (`use` trees, `crate::physics::...`,
 //! `super::...`, `self::...` and paths that start at one of its own child
 //! modules; re-exports count too). No module may depend, directly or
@@ -11,7 +13,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-/// Module path (below `physics`) of each file, e.g. `space::modal::cubature`.
+/// Module path (below the top module) of each file, e.g. `space::modal::cubature`.
 fn modules(root: &Path) -> BTreeMap<Vec<String>, PathBuf> {
     let mut out = BTreeMap::new();
     let mut stack = vec![root.to_path_buf()];
@@ -172,12 +174,13 @@ fn named_paths(code: &str) -> Vec<(usize, String)> {
     paths
 }
 
-/// The module of `physics` a path names from module `here`, if any.
-fn resolve(path: &str, here: &[String], known: &BTreeSet<Vec<String>>) -> Option<Vec<String>> {
+/// The module of `top` (`physics`, `fmi`) a path names from module `here`,
+/// if any; a path to another top module of the crate is `<crate::NAME>`.
+fn resolve_in(top: &str, path: &str, here: &[String], known: &BTreeSet<Vec<String>>) -> Option<Vec<String>> {
     let segs: Vec<&str> = path.split("::").filter(|s| !s.is_empty()).collect();
     let mut abs: Vec<String> = match segs.first()? {
         &"crate" => {
-            if segs.get(1) != Some(&"physics") {
+            if segs.get(1) != Some(&top) {
                 return Some(vec![format!("<crate::{}>", segs.get(1).unwrap_or(&""))]);
             }
             segs[2..].iter().map(|s| s.to_string()).collect()
@@ -212,9 +215,24 @@ fn resolve(path: &str, here: &[String], known: &BTreeSet<Vec<String>>) -> Option
     Some(abs)
 }
 
+fn resolve(path: &str, here: &[String], known: &BTreeSet<Vec<String>>) -> Option<Vec<String>> {
+    resolve_in("physics", path, here, known)
+}
+
 #[test]
 fn the_physics_modules_form_no_cycle_and_name_no_fmi() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/physics");
+    check_layers("physics", &["fmi", "scenes", "model", "TheModel"]);
+}
+
+#[test]
+fn the_fmi_modules_form_no_cycle_and_name_the_model_only_through_its_binding() {
+    check_layers("fmi", &["model", "physics", "scenes"]);
+}
+
+/// Prints the module graph of `src/TOP/` and fails on a cycle or on a path
+/// to one of the crate's `forbidden` top modules.
+fn check_layers(top: &str, forbidden: &[&str]) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src").join(top);
     let files = modules(&root);
     let known: BTreeSet<Vec<String>> = files.keys().cloned().collect();
     let mut edges: BTreeMap<Vec<String>, BTreeSet<Vec<String>>> = BTreeMap::new();
@@ -227,10 +245,10 @@ fn the_physics_modules_form_no_cycle_and_name_no_fmi() {
             // Inside `mod tests { ... }` the path starts one module further down.
             let mut here = module.clone();
             here.extend(inline.iter().filter(|(s, e, _)| *s < at && at < *e).map(|(_, _, n)| n.clone()));
-            match resolve(&p, &here, &known) {
+            match resolve_in(top, &p, &here, &known) {
                 Some(target) if target.first().is_some_and(|t| t.starts_with("<crate::")) => {
                     let t = &target[0];
-                    if t == "<crate::fmi>" || t == "<crate::scenes>" {
+                    if forbidden.iter().any(|f| *t == format!("<crate::{f}>")) {
                         outside.push(format!("{} names {p}", path.display()));
                     }
                 }
@@ -241,11 +259,11 @@ fn the_physics_modules_form_no_cycle_and_name_no_fmi() {
             }
         }
     }
-    let name = |m: &Vec<String>| if m.is_empty() { "physics".to_string() } else { m.join("::") };
+    let name = |m: &Vec<String>| if m.is_empty() { top.to_string() } else { m.join("::") };
     for (m, deps) in &edges {
         println!("{} -> {}", name(m), deps.iter().map(name).collect::<Vec<_>>().join(", "));
     }
-    assert!(outside.is_empty(), "the physics core names the FMI layer: {outside:#?}");
+    assert!(outside.is_empty(), "src/{top} names a module it must not know: {outside:#?}");
     // Depth-first search for a back edge.
     #[derive(Clone, Copy, PartialEq)]
     enum Mark {
@@ -285,7 +303,7 @@ fn the_physics_modules_form_no_cycle_and_name_no_fmi() {
     for m in edges.keys() {
         if mark[m] == Mark::New {
             if let Some(cycle) = visit(m, &edges, &mut mark, &mut Vec::new()) {
-                panic!("import cycle in src/physics: {}", cycle.iter().map(|m| name(m)).collect::<Vec<_>>().join(" -> "));
+                panic!("import cycle in src/{top}: {}", cycle.iter().map(|m| name(m)).collect::<Vec<_>>().join(" -> "));
             }
         }
     }
