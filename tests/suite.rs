@@ -18,6 +18,7 @@ mod anchor;
 mod bake;
 mod basis;
 mod cubature;
+mod defaults;
 mod fmi_abi;
 mod fmi_import;
 mod fmi_mode_classes;

@@ -10,7 +10,7 @@ use common::*;
 use modal_mass_spring::fmi::variables::vr;
 use modal_mass_spring::measures::{trajectory_errors_by_window, Masses};
 use modal_mass_spring::physics::setup::basis::linearize;
-use modal_mass_spring::physics::setup::trained_basis::{program, MAX_TIME};
+use modal_mass_spring::physics::setup::trained_basis::program;
 use modal_mass_spring::physics::*;
 use modal_mass_spring::scenes::{self, Setup};
 
@@ -191,7 +191,7 @@ fn a_training_range_out_of_bounds_is_refused() {
         (TrainingProgram { tilt: -0.1, ..TrainingProgram::default() }, Quantity::TrainingTilt),
         (TrainingProgram { tilt: 1.6, ..TrainingProgram::default() }, Quantity::TrainingTilt),
         (TrainingProgram { time: 0.0, ..TrainingProgram::default() }, Quantity::TrainingTime),
-        (TrainingProgram { time: MAX_TIME * 1.01, ..TrainingProgram::default() }, Quantity::TrainingTime),
+        (TrainingProgram { time: -1.0, ..TrainingProgram::default() }, Quantity::TrainingTime),
         (TrainingProgram { time: f64::INFINITY, ..TrainingProgram::default() }, Quantity::TrainingTime),
     ] {
         let settings = Settings { training, ..trained(4, false, ForceEvaluation::Exact) };

@@ -104,6 +104,40 @@ impl Spec {
             }
             let _ = writeln!(r, "        }}\n    }}\n}}");
         }
+        r.push_str(&self.start_constants());
+        r
+    }
+
+    /// `pub mod start`: the start value of every parameter and input whose
+    /// size is fixed, typed as the physics takes it (f64, bool, a count as
+    /// usize, an enumeration as its enum, a fixed array as `[f64; N]`), so
+    /// the physics' defaults are the table's and written nowhere else.
+    fn start_constants(&self) -> String {
+        let mut r = String::from("\n/// The start values of the variable table (`modelDescription/variables.toml`).\npub mod start {\n    #[allow(unused_imports)]\n    use super::*;\n");
+        for v in self.variables.iter().filter(|v| v.has_start() && v.causality != "output" && v.causality != "local") {
+            let x = v.start_numbers();
+            let dims = v.dims();
+            let fixed: Option<Vec<usize>> = dims.iter().map(|d| if let Dim::Fixed(n) = d { Some(*n as usize) } else { None }).collect();
+            let Some(fixed) = fixed else { continue };
+            let (ty, value) = if !fixed.is_empty() {
+                if v.ty != "Float64" || fixed.len() != 1 || x.len() != fixed[0] {
+                    continue;
+                }
+                (format!("[f64; {}]", fixed[0]), format!("[{}]", x.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(", ")))
+            } else if let Some(e) = v.declared_type.as_ref().and_then(|t| self.enumerations.iter().find(|e| &e.name == t)) {
+                let item = e.items.iter().find(|i| i.value as f64 == x[0]).expect("enumeration start values are items");
+                (e.name.clone(), format!("{}::{}", e.name, variant(&item.name)))
+            } else {
+                match v.ty.as_str() {
+                    "Float64" => ("f64".to_string(), format!("{:?}", x[0])),
+                    "Boolean" => ("bool".to_string(), (x[0] != 0.0).to_string()),
+                    "UInt64" | "UInt32" | "Int64" | "Int32" if x[0] >= 0.0 => ("usize".to_string(), format!("{}", x[0] as u64)),
+                    _ => continue,
+                }
+            };
+            let _ = writeln!(r, "    /// `{}`\n    pub const {}: {ty} = {value};", v.name, screaming(&v.name));
+        }
+        r.push_str("}\n");
         r
     }
 

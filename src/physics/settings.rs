@@ -3,7 +3,11 @@
 //! The enumerations are those of the variable table (`crate::options`,
 //! generated from `modelDescription/variables.toml`), so their items are
 //! defined once; this type gathers them with the numbers that go with them.
+//! Its defaults are the table's start values (`crate::options::start`),
+//! written nowhere else; the physics checks only what makes a value
+//! physically meaningless, the table's ranges are the FMU's.
 
+use crate::options::start;
 pub use crate::options::{ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction};
 
 /// Everything the set-up of a [`crate::physics::Simulator`] chooses besides the scene and the loads.
@@ -55,38 +59,39 @@ pub struct Settings {
 /// settings announce, and the point load's range).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TrainingProgram {
-    /// Relative change of gravity's magnitude, in [0, 1).
+    /// Relative change of gravity's magnitude, in [0, 1) (1 - scale > 0: gravity keeps its sense).
     pub scale: f64,
     /// Tilt of gravity's direction [rad], in [0, pi/2].
     pub tilt: f64,
-    /// Length of each training run [s], in (0, 10].
+    /// Length of each training run [s], positive.
     pub time: f64,
 }
 
 impl Default for TrainingProgram {
-    /// 0.7 to 1.3 times the set-up gravity, tilted up to 20 degrees, 1 s per run.
+    /// The table's start values: 0.7 to 1.3 times the set-up gravity, tilted up to 20 degrees, 1 s per run.
     fn default() -> Self {
-        TrainingProgram { scale: 0.3, tilt: 20f64.to_radians(), time: 1.0 }
+        TrainingProgram { scale: start::TRAINING_SCALE, tilt: start::TRAINING_TILT, time: start::TRAINING_TIME }
     }
 }
 
 impl Settings {
-    /// `n_modes` modes, the given space and scheme, the paper's basis (the
-    /// lowest modes at rest, no correction) and forces (every spring),
-    /// internal steps of at most 10 ms.
+    /// `n_modes` modes, the given space and scheme, and every other choice
+    /// at the table's start value: the paper's basis (the lowest modes at
+    /// rest, no correction) and forces (every spring), internal steps of at
+    /// most 10 ms.
     pub fn new(reduction: Reduction, integrator: Integrator, n_modes: usize) -> Self {
         Settings {
             reduction,
             integrator,
             n_modes,
-            mode_selection: ModeSelection::Lowest,
-            static_correction: false,
-            linearization: Linearization::Rest,
-            anchor_motion: false,
-            anchor_rotation: false,
-            force_evaluation: ForceEvaluation::Exact,
-            cubature_tolerance: 0.01,
-            max_internal_step: 0.01,
+            mode_selection: start::MODE_SELECTION,
+            static_correction: start::STATIC_CORRECTION,
+            linearization: start::LINEARIZATION,
+            anchor_motion: start::ANCHOR_MOTION,
+            anchor_rotation: start::ANCHOR_ROTATION,
+            force_evaluation: start::FORCE_EVALUATION,
+            cubature_tolerance: start::CUBATURE_TOLERANCE,
+            max_internal_step: start::MAX_INTERNAL_STEP,
             substepping: true,
             training: TrainingProgram::default(),
         }

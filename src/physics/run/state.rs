@@ -8,6 +8,7 @@
 //! - [`Snapshot`]: a state with its loads, all a run needs to resume. The
 //!   simulator's backup before a step and the FMU state are snapshots.
 
+use crate::options::start;
 use crate::physics::error::{non_negative, PhysicsError, Quantity};
 use crate::physics::setup::scene::Scene;
 
@@ -150,13 +151,13 @@ impl Loads {
     /// Earth gravity along -y, no damping, every weight 1 (the physical model).
     pub fn physical(n_modes: usize) -> Self {
         Loads {
-            gravity: [0.0, -9.81, 0.0],
-            point_load: [0.0; 3],
+            gravity: start::GRAVITY,
+            point_load: [start::LOAD_X, start::LOAD_Y, start::LOAD_Z],
             load_node: None,
-            anchor: [0.0; 3],
-            rotation: [0.0; 3],
-            damping_alpha: 0.0,
-            damping_beta: 0.0,
+            anchor: [start::ANCHOR_X, start::ANCHOR_Y, start::ANCHOR_Z],
+            rotation: [start::ANCHOR_R_X, start::ANCHOR_R_Y, start::ANCHOR_R_Z],
+            damping_alpha: start::DAMPING_ALPHA,
+            damping_beta: start::DAMPING_BETA,
             mode_weights: vec![1.0; n_modes],
         }
     }
