@@ -29,10 +29,10 @@ use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use fmi_sys::fmi3::*;
+use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::fmi::exports::*;
 use modal_mass_spring::fmi::variables::{vr, INSTANTIATION_TOKEN};
 use modal_mass_spring::physics::*;
-use modal_mass_spring::scenes;
 
 const PER_CALL: usize = 100;
 
@@ -50,8 +50,8 @@ fn simulator(p: &Grid, s: &Settings) -> (Simulator, f64) {
 }
 
 fn internal_step(c: &mut Criterion) {
-    for name in scenes::names() {
-        let p = scenes::canonical(name).unwrap().grid;
+    for name in canonical_scenes::names() {
+        let p = canonical_scenes::canonical(name).unwrap().grid;
         let n = p.build().unwrap().n_dofs();
         let mut group = c.benchmark_group(format!("internal_step/{name}"));
         for &integrator in Integrator::ALL {
@@ -85,7 +85,7 @@ fn internal_step(c: &mut Criterion) {
 fn cubature(c: &mut Criterion) {
     const STEPS: usize = 1000;
     for n in [30, 100] {
-        let setup = scenes::cloth(n, n);
+        let setup = canonical_scenes::cloth(n, n);
         let mut group = c.benchmark_group(format!("cubature/cloth-3d-{n}x{n}"));
         group.sample_size(20);
         for &evaluation in ForceEvaluation::ALL {
@@ -116,7 +116,7 @@ unsafe extern "C" fn silent(_: fmi3InstanceEnvironment, _: fmi3Status, _: fmi3St
 
 fn do_step(c: &mut Criterion) {
     let name = "paper-2d-top-row";
-    let p = scenes::canonical(name).unwrap().grid;
+    let p = canonical_scenes::canonical(name).unwrap().grid;
     let s = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 2);
     let (mut many, dt) = simulator(&p, &s);
     let (mut one, _) = simulator(&p, &s);

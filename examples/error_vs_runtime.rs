@@ -11,8 +11,8 @@ mod common;
 use common::error;
 use std::time::Instant;
 
+use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::physics::*;
-use modal_mass_spring::scenes;
 
 struct Run {
     frames: Vec<Vec<f64>>,
@@ -61,7 +61,7 @@ fn main() {
         std::process::exit(2)
     });
     let name = name.as_str();
-    let p = scenes::canonical(name).expect("unknown scene").grid;
+    let p = canonical_scenes::canonical(name).expect("unknown scene").grid;
     let n = p.build().unwrap().n_dofs();
     let frames = (seconds * 100.0).round() as usize; // output every 10 ms
     let full = |integrator, h: f64| solver(integrator, None, h);

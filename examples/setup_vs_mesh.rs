@@ -17,9 +17,9 @@
 
 use std::time::Instant;
 
+use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::physics::setup::{basis, trained_basis};
 use modal_mass_spring::physics::{Integrator, ModeSelection, Reduction, Settings, Simulator};
-use modal_mass_spring::scenes;
 
 struct Args {
     sizes: Vec<usize>,
@@ -70,7 +70,7 @@ fn main() {
     for &n in &sizes {
         for &selection in &selections {
             for &static_correction in &corrections {
-                let setup = scenes::cloth(n, n).with_settings(solver(modes, selection, static_correction));
+                let setup = canonical_scenes::cloth(n, n).with_settings(solver(modes, selection, static_correction));
                 let select = selection.name();
                 let correction = if static_correction { "static" } else { "none" };
                 let scene = setup.grid.build().expect("cloth scene");

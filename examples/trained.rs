@@ -9,9 +9,9 @@
 
 use std::time::Instant;
 
+use modal_mass_spring::canonical_scenes::{self, Setup};
 use modal_mass_spring::measures::{trajectory_errors_by_window, Masses};
 use modal_mass_spring::physics::*;
-use modal_mass_spring::scenes::{self, Setup};
 
 const H: f64 = 0.01;
 
@@ -67,7 +67,7 @@ fn main() {
         }
     };
     let only: Vec<String> = args.iter().enumerate().filter(|(_, a)| *a == "--variant").map(|(i, _)| args[i + 1].clone()).collect();
-    let base = scenes::cloth(nx, nx);
+    let base = canonical_scenes::cloth(nx, nx);
     let cases = [
         ("canonical", gravity(1.0, 0.0, 0.0)),
         ("0.85 g tilted 10 deg in x and z", gravity(0.85, 10.0, 10.0)),

@@ -15,8 +15,8 @@ mod common;
 use common::error;
 use std::time::Instant;
 
+use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::physics::*;
-use modal_mass_spring::scenes;
 
 const REFERENCE_DT: f64 = 1e-4;
 
@@ -54,7 +54,7 @@ fn simulate(p: &Grid, s: &Settings, h: f64, every: usize, seconds: f64) -> Resul
 }
 
 fn compare(scene: &str, h: f64, modes: &[usize], seconds: f64) {
-    let p = scenes::canonical(scene).expect("canonical scene").grid;
+    let p = canonical_scenes::canonical(scene).expect("canonical scene").grid;
     let d = p.dim;
     let every_ref = (h / REFERENCE_DT).round() as usize;
     let full = |dt: f64| solver(Reduction::Full, Integrator::NewmarkExplicit, 0, dt);
@@ -84,7 +84,7 @@ fn compare(scene: &str, h: f64, modes: &[usize], seconds: f64) {
 /// steps: its largest distance from the start, relative to the largest
 /// kinetic energy, over the first and the last tenth of the run.
 fn drift(scene: &str, r: usize, h: f64, steps: usize) {
-    let p = scenes::canonical(scene).expect("canonical scene").grid;
+    let p = canonical_scenes::canonical(scene).expect("canonical scene").grid;
     let s = solver(Reduction::Modal, Integrator::Trigonometric, r, h);
     let mut sim = Simulator::new(p.build().unwrap(), &s, &Loads::physical(r)).unwrap();
     let e0 = sim.kinetic_energy() + sim.potential_energy();

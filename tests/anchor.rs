@@ -8,13 +8,13 @@
 use crate::common;
 
 use common::*;
+use modal_mass_spring::canonical_scenes::{self, Setup};
 use modal_mass_spring::fmi::variables::vr;
 use modal_mass_spring::physics::*;
-use modal_mass_spring::scenes::{self, Setup};
 
 /// The paper's 2D scene on a `columns` x `rows` grid with `solver`.
 fn small(columns: usize, rows: usize, solver: Settings) -> Setup {
-    let mut setup = scenes::canonical("paper-2d-top-row").unwrap();
+    let mut setup = canonical_scenes::canonical("paper-2d-top-row").unwrap();
     setup.grid.columns = columns;
     setup.grid.rows = rows;
     setup.loads.load_node = None;
@@ -177,7 +177,7 @@ fn equivalence_principle() {
         let mut errors = Vec::new();
         for h in [0.02, 0.01, 0.005] {
             let steps = (1.0 / h) as usize;
-            let setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver.clone());
+            let setup = canonical_scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver.clone());
             let mut moving = setup.simulator().unwrap();
             let parabola = |t: f64| [0.5 * accel[0] * t * t, 0.5 * accel[1] * t * t, 0.0];
             let got = drive(&mut moving, steps, h, parabola);
@@ -207,7 +207,7 @@ fn every_mode_matches_the_full_space_with_anchor_motion_and_a_load() {
     let run = |reduction| {
         let mut solver = Settings::new(reduction, Integrator::NewmarkExplicit, if reduction == Reduction::Modal { 180 } else { 0 });
         solver.max_internal_step = 2e-4;
-        let setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
+        let setup = canonical_scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
         let mut sim = setup.simulator().unwrap();
         assert!(sim.max_stable_step() == 2e-4);
         let mut trace = Vec::new();
@@ -240,7 +240,7 @@ fn every_mode_matches_the_full_space_with_anchor_motion_and_a_load() {
 fn response(weights: &[f64], j: usize, omega: f64, seconds: f64) -> f64 {
     let mut solver = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, weights.len());
     solver.max_internal_step = 1e-3;
-    let mut setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
+    let mut setup = canonical_scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
     setup.loads.gravity = [0.0; 3];
     setup.loads.mode_weights = weights.to_vec();
     let mut sim = setup.simulator().unwrap();
@@ -263,7 +263,7 @@ fn response(weights: &[f64], j: usize, omega: f64, seconds: f64) -> f64 {
 fn harmonic_anchor_motion_resonates_in_its_mode_and_not_in_a_deleted_one() {
     let r = 4;
     let solver = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, r);
-    let setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
+    let setup = canonical_scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
     let sim = setup.simulator().unwrap();
     let omegas = sim.mode_frequencies().to_vec();
     // The lowest mode is the sheet swinging sideways: an anchor moving along x drives it.
@@ -291,7 +291,7 @@ fn a_moving_anchor_is_a_load_pattern() {
     let (h, steps) = (0.01, 100);
     let mut reference_solver = full(1e-3);
     reference_solver.max_internal_step = 1e-3;
-    let setup = scenes::canonical("paper-2d-top-row").unwrap();
+    let setup = canonical_scenes::canonical("paper-2d-top-row").unwrap();
     let want = drive(&mut setup.with_settings(reference_solver).simulator().unwrap(), steps, h, path);
     let mut errors = Vec::new();
     for anchor_motion in [false, true] {
@@ -400,7 +400,7 @@ fn fmi_state_with_a_moving_anchor_resumes_bit_for_bit() {
 /// rates came before it, and after a restored state at that state's rate.
 #[test]
 fn held_nodes_move_at_the_anchor_rate_of_the_step() {
-    let mut sim = scenes::canonical("paper-2d-top-row").unwrap().simulator().unwrap();
+    let mut sim = canonical_scenes::canonical("paper-2d-top-row").unwrap().simulator().unwrap();
     sim.do_step(0.02).unwrap();
     let start = sim.snapshot();
     for (k, target) in [0.01, 0.03, 0.02].into_iter().enumerate() {
@@ -434,7 +434,7 @@ fn port_outputs_alone_are_the_bits_of_the_full_outputs() {
     for (label, solver) in
         [("full space", full(0.01)), ("modal, lowest 6", Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 6)), ("modal, cubature", cubature)]
     {
-        let setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
+        let setup = canonical_scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
         let (mut alone, mut after) = (setup.simulator().unwrap(), setup.simulator().unwrap());
         for k in 0..40 {
             for sim in [&mut alone, &mut after] {

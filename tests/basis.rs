@@ -4,13 +4,13 @@
 use crate::common;
 
 use common::*;
+use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::fmi::exports::{fmi3EnterInitializationMode, fmi3ExitInitializationMode};
 use modal_mass_spring::fmi::variables::vr;
 use modal_mass_spring::physics::run::forces::{SpringForces, StiffnessPattern};
 use modal_mass_spring::physics::setup::basis::{self, Basis};
 use modal_mass_spring::physics::setup::equilibrium::equilibrium;
 use modal_mass_spring::physics::*;
-use modal_mass_spring::scenes;
 
 fn options(mode_selection: ModeSelection, static_correction: bool, linearization: Linearization) -> Settings {
     Settings { mode_selection, static_correction, linearization, ..paper() }
@@ -22,7 +22,7 @@ fn paper() -> Settings {
 }
 
 fn build(scene: &str, r: usize, o: &Settings) -> (Scene, Basis) {
-    let setup = scenes::canonical(scene).unwrap();
+    let setup = canonical_scenes::canonical(scene).unwrap();
     let s = setup.grid.build().unwrap();
     let b = basis::build(&s, &setup.loads, r, o).unwrap();
     (s, b)
@@ -90,7 +90,7 @@ fn ritz_vectors_are_mass_orthonormal_and_diagonalise_k() {
         }
         // modeFrequencies are the Ritz values.
         let solver = Settings { n_modes: 8, ..o.clone() };
-        let sim = scenes::canonical(scene).unwrap().with_settings(solver).simulator().unwrap();
+        let sim = canonical_scenes::canonical(scene).unwrap().with_settings(solver).simulator().unwrap();
         for (w, l) in sim.mode_frequencies().iter().zip(&b.modes.lambda) {
             assert!((w * w - l).abs() <= 1e-12 * l.max(1.0), "{scene}: frequency {w}, lambda {l}");
         }
@@ -130,7 +130,7 @@ fn the_static_correction_holds_the_sag() {
     assert!(outside(&s, &plain, &sag) > 1e-3, "without the correction the sag lies outside the basis");
     // At the equilibrium: the displacement from rest, so a run starts exactly at rest.
     let solver = Settings { n_modes: 4, ..options(ModeSelection::Load, true, Linearization::Equilibrium) };
-    let setup = scenes::canonical("paper-2d-top-corners").unwrap().with_settings(solver);
+    let setup = canonical_scenes::canonical("paper-2d-top-corners").unwrap().with_settings(solver);
     let mut sim = setup.simulator().unwrap();
     let rest = setup.grid.build().unwrap();
     let d = rest.dim;
@@ -142,7 +142,7 @@ fn the_static_correction_holds_the_sag() {
 #[test]
 fn the_equilibrium_balances_gravity_and_matches_a_damped_run() {
     for name in ["paper-2d-top-corners", "paper-3d-sheet"] {
-        let setup = scenes::canonical(name).unwrap();
+        let setup = canonical_scenes::canonical(name).unwrap();
         let s = setup.grid.build().unwrap();
         let pattern = StiffnessPattern::new(&s);
         let x = equilibrium(&s, &pattern, &modal_mass_spring::physics::setup::basis::external_load(&s, &setup.loads)).unwrap();
@@ -169,7 +169,7 @@ fn the_equilibrium_balances_gravity_and_matches_a_damped_run() {
 #[test]
 fn the_equilibrium_removes_the_zero_eigenvalues_of_a_flat_3d_sheet() {
     // Without auxiliary springs a flat sheet has no stiffness out of its plane at rest.
-    let mut setup = scenes::canonical("paper-3d-sheet").unwrap();
+    let mut setup = canonical_scenes::canonical("paper-3d-sheet").unwrap();
     setup.grid.aux_stiffness = 0.0;
     let s = setup.grid.build().unwrap();
     let all = s.n_dofs();
@@ -196,7 +196,7 @@ fn the_equilibrium_removes_the_zero_eigenvalues_of_a_flat_3d_sheet() {
 
 #[test]
 fn all_modes_at_the_equilibrium_reproduce_full_space_to_round_off() {
-    let setup = scenes::canonical("paper-2d-top-corners").unwrap();
+    let setup = canonical_scenes::canonical("paper-2d-top-corners").unwrap();
     let n = setup.grid.build().unwrap().n_dofs();
     for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit] {
         let mut modal = Settings::new(Reduction::Modal, integrator, n);
@@ -310,7 +310,7 @@ fn with_cubature_the_residual_check_runs_after_a_load_change_and_every_few_steps
     solver.mode_selection = ModeSelection::Load;
     solver.static_correction = true;
     solver.force_evaluation = ForceEvaluation::Cubature;
-    let mut sim = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver.clone()).simulator().unwrap();
+    let mut sim = canonical_scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver.clone()).simulator().unwrap();
     sim.do_step(0.01).unwrap();
     let (all, visited) = (sim.scene().springs.len(), sim.cubature_springs() * sim.internal_steps_last());
     let period = modal_mass_spring::model::residual_period(&sim);
@@ -320,7 +320,7 @@ fn with_cubature_the_residual_check_runs_after_a_load_change_and_every_few_steps
     // Exact forces and full space visit every spring each step: a check after every step.
     for (reduction, evaluation) in [(Reduction::Modal, ForceEvaluation::Exact), (Reduction::Full, ForceEvaluation::Exact)] {
         let s = Settings { reduction, force_evaluation: evaluation, ..solver.clone() };
-        let mut sim = scenes::canonical("paper-2d-top-row").unwrap().with_settings(s).simulator().unwrap();
+        let mut sim = canonical_scenes::canonical("paper-2d-top-row").unwrap().with_settings(s).simulator().unwrap();
         sim.do_step(0.01).unwrap();
         assert_eq!(modal_mass_spring::model::residual_period(&sim), 1, "{reduction:?}");
     }

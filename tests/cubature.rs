@@ -6,10 +6,10 @@
 use crate::common;
 
 use common::*;
+use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::fmi::variables::vr;
 use modal_mass_spring::measures::{trajectory_error, Masses};
 use modal_mass_spring::physics::*;
-use modal_mass_spring::scenes;
 
 fn solver(integrator: Integrator, r: usize, linearization: Linearization, force: ForceEvaluation, tolerance: f64) -> Settings {
     let mut s = Settings::new(Reduction::Modal, integrator, r);
@@ -72,7 +72,7 @@ fn cubature_reproduces_the_projected_force_on_held_out_poses() {
         ("cloth-3d", 16, Linearization::Rest),
     ] {
         for tolerance in [0.01, 0.002] {
-            let setup = scenes::canonical(name).unwrap();
+            let setup = canonical_scenes::canonical(name).unwrap();
             let mut exact = setup.with_settings(solver(Integrator::NewmarkExplicit, r, lin, ForceEvaluation::Exact, tolerance)).simulator().unwrap();
             let mut cubature = setup.with_settings(solver(Integrator::NewmarkExplicit, r, lin, ForceEvaluation::Cubature, tolerance)).simulator().unwrap();
             let poses = held_out_poses(&mut exact);
@@ -87,7 +87,7 @@ fn cubature_reproduces_the_projected_force_on_held_out_poses() {
 
 #[test]
 fn cubature_runs_follow_exact_forces_with_both_integrators() {
-    let setup = scenes::canonical("paper-2d-top-row").unwrap();
+    let setup = canonical_scenes::canonical("paper-2d-top-row").unwrap();
     for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit] {
         let frames = |force| {
             let mut s = solver(integrator, 8, Linearization::Rest, force, 0.002);
@@ -128,7 +128,7 @@ fn the_fmu_reports_the_springs_it_keeps_and_refuses_bad_tolerances() {
         f.get_u64(vr::CUBATURE_SPRINGS)
     };
     let (exact, cubature) = (springs(1), springs(2));
-    let all = scenes::canonical("paper-2d-top-row").unwrap().grid.build().unwrap().springs.len() as u64;
+    let all = canonical_scenes::canonical("paper-2d-top-row").unwrap().grid.build().unwrap().springs.len() as u64;
     assert_eq!(exact, all);
     assert!(cubature > 0 && cubature < all / 4, "{cubature} of {all}");
 }
@@ -139,7 +139,7 @@ fn the_fmu_reports_the_springs_it_keeps_and_refuses_bad_tolerances() {
 /// cubature forces, both schemes; and reading does not change the run.
 #[test]
 fn outputs_read_or_not_give_the_same_run() {
-    let p = scenes::canonical("paper-2d-top-row").unwrap().grid;
+    let p = canonical_scenes::canonical("paper-2d-top-row").unwrap().grid;
     for force in [ForceEvaluation::Exact, ForceEvaluation::Cubature] {
         for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit] {
             let s = solver(integrator, 8, Linearization::Rest, force, 0.01);

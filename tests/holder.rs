@@ -5,10 +5,10 @@
 //! instant; every mode kept, the full space's to round-off; a reduced basis
 //! prepared for the motion close to full space through a swing.
 
+use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::physics::run::forces::pull;
 use modal_mass_spring::physics::run::frame::cross;
 use modal_mass_spring::physics::*;
-use modal_mass_spring::scenes;
 
 /// 1 N along x, 2 N along -y (and 0.5 N along z in 3D) on the load node.
 const LOAD: [f64; 3] = [1.0, -2.0, 0.5];
@@ -45,7 +45,7 @@ fn variants(dofs: usize) -> Vec<(&'static str, Settings)> {
 /// The scene `name` with `solver`, the point load on its load node and
 /// mass-proportional damping `alpha`.
 fn simulator(name: &str, solver: Settings, alpha: f64) -> Simulator {
-    let mut setup = scenes::canonical(name).unwrap().with_settings(solver);
+    let mut setup = canonical_scenes::canonical(name).unwrap().with_settings(solver);
     setup.loads.point_load = LOAD;
     setup.loads.damping_alpha = alpha;
     setup.simulator().unwrap()

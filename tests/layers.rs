@@ -7,7 +7,7 @@
 //! `super::...`, `self::...` and paths that start at one of its own child
 //! modules; re-exports count too). No module may depend, directly or
 //! through others, on a module that depends on it, and no module may name
-//! `crate::fmi` or `crate::scenes`. The test prints the module graph it
+//! `crate::fmi` or `crate::canonical_scenes`. The test prints the module graph it
 //! read, so a failure shows the cycle and the edges behind it.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -221,12 +221,12 @@ fn resolve(path: &str, here: &[String], known: &BTreeSet<Vec<String>>) -> Option
 
 #[test]
 fn the_physics_modules_form_no_cycle_and_name_no_fmi() {
-    check_layers("physics", &["fmi", "scenes", "model", "TheModel"]);
+    check_layers("physics", &["fmi", "canonical_scenes", "model", "TheModel"]);
 }
 
 #[test]
 fn the_fmi_modules_form_no_cycle_and_name_the_model_only_through_its_binding() {
-    check_layers("fmi", &["model", "physics", "scenes"]);
+    check_layers("fmi", &["model", "physics", "canonical_scenes"]);
 }
 
 /// Prints the module graph of `src/TOP/` and fails on a cycle or on a path

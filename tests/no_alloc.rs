@@ -7,8 +7,8 @@
 use crate::counting;
 
 use counting::allocations;
+use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::physics::*;
-use modal_mass_spring::scenes;
 
 /// Every space and scheme, with the paper's basis and with each option
 /// (modes chosen by the load, static correction, linearization at the
@@ -34,7 +34,7 @@ fn do_step_allocates_nothing() {
                     if reduction == Reduction::Modal { &options[..] } else { &options[..1] }
                 {
                     let solver = Settings { mode_selection, static_correction, linearization, force_evaluation, ..Settings::new(reduction, integrator, 4) };
-                    let mut setup = scenes::canonical(name).unwrap().with_settings(solver);
+                    let mut setup = canonical_scenes::canonical(name).unwrap().with_settings(solver);
                     setup.loads.damping_beta = 1e-3; // exercises the factorised explicit velocity update too
                                                      // A point load on the load node of the scene (a load pattern of the basis options too).
                     setup.loads.point_load = [0.01, -0.02, 0.0];

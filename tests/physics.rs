@@ -1,14 +1,14 @@
 //! Physics core checks: modes, frequencies, modal vs full space, weights,
 //! sub-stepping, snapshots.
 
+use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::physics::run::forces::StiffnessPattern;
 use modal_mass_spring::physics::setup::modes::ModalBasis;
 use modal_mass_spring::physics::setup::scene::Scene;
 use modal_mass_spring::physics::*;
-use modal_mass_spring::scenes;
 
 fn scene(name: &str) -> Grid {
-    scenes::canonical(name).unwrap().grid
+    canonical_scenes::canonical(name).unwrap().grid
 }
 
 fn solver(reduction: Reduction, integrator: Integrator, n_modes: usize) -> Settings {
@@ -289,7 +289,7 @@ fn gravity_change_changes_motion_and_modal_sags() {
 fn partial_eigensolver_matches_the_dense_one() {
     // Above the size where `lowest` switches to the shift-invert Krylov-Schur solver.
     let corners = Grid { columns: 24, rows: 18, ..scene("paper-2d-top-corners") };
-    for p in [scenes::cloth(20, 20).grid, corners] {
+    for p in [canonical_scenes::cloth(20, 20).grid, corners] {
         let s = p.build().unwrap();
         let pat = StiffnessPattern::new(&s);
         let mut k0 = vec![0.0; pat.nnz()];

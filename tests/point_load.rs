@@ -7,9 +7,9 @@
 use crate::common;
 
 use common::*;
+use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::fmi::variables::vr;
 use modal_mass_spring::physics::*;
-use modal_mass_spring::scenes;
 
 /// 2 N along -y and 1 N along x, as the tests apply it.
 const LOAD: [f64; 3] = [1.0, -2.0, 0.0];
@@ -18,7 +18,7 @@ const LOAD: [f64; 3] = [1.0, -2.0, 0.0];
 /// load on its default load node (row 9, column 5) and mass-proportional
 /// damping `alpha`.
 fn loaded(solver: Settings, alpha: f64) -> (Simulator, f64) {
-    let mut setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
+    let mut setup = canonical_scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
     assert_eq!(setup.loads.load_node, Some(9 * 10 + 5), "the default load node is the middle of the bottom row");
     setup.loads.point_load = LOAD;
     setup.loads.damping_alpha = alpha;
@@ -68,7 +68,7 @@ fn every_mode_matches_the_full_space_with_a_load_switched_on() {
     let run = |reduction| {
         let mut solver = Settings::new(reduction, Integrator::NewmarkExplicit, if reduction == Reduction::Modal { 180 } else { 0 });
         solver.max_internal_step = 2e-4; // below both stable steps: the same internal steps in both spaces
-        let setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
+        let setup = canonical_scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
         let mut sim = setup.simulator().unwrap();
         assert!(sim.max_stable_step() == 2e-4, "{reduction:?}: stable step {} below the bound", sim.max_stable_step());
         let mut trace = Vec::new();
@@ -84,7 +84,7 @@ fn every_mode_matches_the_full_space_with_a_load_switched_on() {
         trace
     };
     let (full, modal) = (run(Reduction::Full), run(Reduction::Modal));
-    let rest = scenes::canonical("paper-2d-top-row").unwrap().grid.build().unwrap();
+    let rest = canonical_scenes::canonical("paper-2d-top-row").unwrap().grid.build().unwrap();
     let scale = rest.length_scale();
     let mut worst: f64 = 0.0;
     for (k, ((xf, af, nf), (xm, am, nm))) in full.iter().zip(&modal).enumerate() {
@@ -105,7 +105,7 @@ fn every_mode_matches_the_full_space_with_a_load_switched_on() {
 
 #[test]
 fn a_point_load_needs_a_free_node_and_finite_values() {
-    let setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 4));
+    let setup = canonical_scenes::canonical("paper-2d-top-row").unwrap().with_settings(Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 4));
     let mut sim = setup.simulator().unwrap();
     sim.do_step(0.01).unwrap();
     let before = sim.snapshot();
@@ -131,7 +131,7 @@ fn the_point_load_alone_is_a_load_pattern() {
     solver.mode_selection = ModeSelection::Load;
     solver.static_correction = true;
     solver.linearization = Linearization::Equilibrium;
-    let mut setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
+    let mut setup = canonical_scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
     setup.loads.gravity = [0.0; 3];
     assert_eq!(setup.simulator().err(), Some(PhysicsError::NoLoad));
     setup.loads.point_load = LOAD;

@@ -6,9 +6,9 @@
 //! the perturbation. E measured on either over the whole run says as much
 //! about the scene as about any model.
 
+use modal_mass_spring::canonical_scenes::{self, Setup};
 use modal_mass_spring::measures::{predictability, trajectory_errors_by_window, twin_offset, Masses};
 use modal_mass_spring::physics::*;
-use modal_mass_spring::scenes::{self, Setup};
 
 const H: f64 = 0.01;
 
@@ -45,8 +45,8 @@ fn horizon(setup: Setup, steps: usize) -> (Option<f64>, f64) {
 
 #[test]
 fn cloth_is_predictable_for_a_while_the_paper_sheet_throughout() {
-    let (cloth, cloth_floor) = horizon(scenes::cloth(12, 12), 200);
-    let (paper, paper_floor) = horizon(scenes::canonical("paper-2d-top-row").unwrap(), 200);
+    let (cloth, cloth_floor) = horizon(canonical_scenes::cloth(12, 12), 200);
+    let (paper, paper_floor) = horizon(canonical_scenes::canonical("paper-2d-top-row").unwrap(), 200);
     println!(
         "cloth 12 x 12: horizon {cloth:?} s, twins' E over 2 s {cloth_floor:.2e}; paper-2d-top-row: horizon {paper:?}, twins' E over 2 s {paper_floor:.2e}"
     );
@@ -58,8 +58,11 @@ fn cloth_is_predictable_for_a_while_the_paper_sheet_throughout() {
 
 #[test]
 fn a_twin_start_of_the_wrong_size_or_not_finite_is_refused_with_the_state_kept() {
-    let mut sim =
-        scenes::canonical("paper-2d-top-row").unwrap().with_settings(Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 4)).simulator().unwrap();
+    let mut sim = canonical_scenes::canonical("paper-2d-top-row")
+        .unwrap()
+        .with_settings(Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 4))
+        .simulator()
+        .unwrap();
     sim.do_step(H).unwrap();
     let before = sim.snapshot();
     assert_eq!(sim.displace(&[0.0; 3]), Err(PhysicsError::SnapshotLength { len: 3, expected: 4 }));

@@ -7,12 +7,12 @@
 use crate::common;
 
 use common::*;
+use modal_mass_spring::canonical_scenes::{self, Setup};
 use modal_mass_spring::fmi::variables::vr;
 use modal_mass_spring::measures::{trajectory_errors_by_window, Masses};
 use modal_mass_spring::physics::setup::basis::linearize;
 use modal_mass_spring::physics::setup::trained_basis::program;
 use modal_mass_spring::physics::*;
-use modal_mass_spring::scenes::{self, Setup};
 
 const H: f64 = 0.01;
 
@@ -50,14 +50,16 @@ fn run(setup: &Setup, g: [f64; 3]) -> (Vec<f64>, Vec<Vec<f64>>, f64) {
 
 /// E over [0, 0.5 s] and [0, 1 s] of `settings` on cloth 30 x 30 under `g` against full space, and the largest trainingRange.
 fn cloth_error(settings: Settings, g: [f64; 3], reference: &[Vec<f64>]) -> (f64, f64, f64) {
-    let (start, frames, range) = run(&scenes::cloth(30, 30).with_settings(settings), g);
+    let (start, frames, range) = run(&canonical_scenes::cloth(30, 30).with_settings(settings), g);
     let e = trajectory_errors_by_window(&frames, reference, &start, Masses::Equal);
     (e[49], e[99], range)
 }
 
 #[test]
 fn a_trained_basis_is_mass_orthonormal_and_diagonalizes_the_stiffness() {
-    for (name, setup, r) in [("paper-2d-top-row", scenes::canonical("paper-2d-top-row").unwrap(), 8), ("cloth 12 x 12", scenes::cloth(12, 12), 16)] {
+    for (name, setup, r) in
+        [("paper-2d-top-row", canonical_scenes::canonical("paper-2d-top-row").unwrap(), 8), ("cloth 12 x 12", canonical_scenes::cloth(12, 12), 16)]
+    {
         for correction in [false, true] {
             let settings = trained(r, correction, ForceEvaluation::Exact);
             let setup = setup.with_settings(settings.clone());
@@ -93,7 +95,7 @@ fn a_trained_basis_is_mass_orthonormal_and_diagonalizes_the_stiffness() {
 
 #[test]
 fn on_cloth_a_trained_basis_reproduces_its_loads_and_loads_inside_its_range_it_never_ran() {
-    let full = scenes::cloth(30, 30).with_settings(Settings::new(Reduction::Full, Integrator::NewmarkExplicit, 0));
+    let full = canonical_scenes::cloth(30, 30).with_settings(Settings::new(Reduction::Full, Integrator::NewmarkExplicit, 0));
     let canonical = gravity(1.0, 0.0, 0.0);
     let held_out = gravity(0.85, 10.0, 10.0);
     let (_, reference, _) = run(&full, canonical);
@@ -121,20 +123,20 @@ fn on_cloth_a_trained_basis_reproduces_its_loads_and_loads_inside_its_range_it_n
 #[test]
 fn a_load_outside_the_training_range_raises_the_indicator() {
     let settings = trained(16, false, ForceEvaluation::Exact);
-    let (_, _, inside) = run(&scenes::cloth(30, 30).with_settings(settings.clone()), gravity(1.0, 0.0, 0.0));
-    let (_, _, outside) = run(&scenes::cloth(30, 30).with_settings(settings), gravity(1.5, 45.0, 0.0));
+    let (_, _, inside) = run(&canonical_scenes::cloth(30, 30).with_settings(settings.clone()), gravity(1.0, 0.0, 0.0));
+    let (_, _, outside) = run(&canonical_scenes::cloth(30, 30).with_settings(settings), gravity(1.5, 45.0, 0.0));
     println!("cloth 30 x 30, r = 16: largest trainingRange {inside:.2} on the canonical load, {outside:.2} at 1.5 g tilted 45 degrees");
     assert!(inside <= 1.2, "{inside}");
     assert!(outside > 3.0, "{outside}");
     // Other bases have no training range.
-    let mut sim = scenes::cloth(12, 12).with_settings(Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 4)).simulator().unwrap();
+    let mut sim = canonical_scenes::cloth(12, 12).with_settings(Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 4)).simulator().unwrap();
     sim.do_step(H).unwrap();
     assert_eq!(sim.training_range(), 0.0);
 }
 
 #[test]
 fn a_trained_set_up_with_cubature_runs_bit_for_bit_from_its_data() {
-    for (setup, r) in [(scenes::canonical("paper-2d-top-row").unwrap(), 6), (scenes::canonical("paper-3d-sheet").unwrap(), 8)] {
+    for (setup, r) in [(canonical_scenes::canonical("paper-2d-top-row").unwrap(), 6), (canonical_scenes::canonical("paper-3d-sheet").unwrap(), 8)] {
         let setup = setup.with_settings(trained(r, true, ForceEvaluation::Cubature));
         let mut computed = setup.simulator().unwrap();
         let data = SetupData::from_bytes(&computed.setup_data().unwrap().to_bytes()).expect("the data reads back");
@@ -160,7 +162,7 @@ fn the_training_program_covers_the_set_up_loads_scaled_and_tilted_and_the_announ
         let n = |v: &[f64; 3]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
         (dot / (n(a) * n(b))).clamp(-1.0, 1.0).acos()
     };
-    for (setup, tilts) in [(scenes::canonical("paper-2d-top-row").unwrap(), 2), (scenes::cloth(12, 12), 4)] {
+    for (setup, tilts) in [(canonical_scenes::canonical("paper-2d-top-row").unwrap(), 2), (canonical_scenes::cloth(12, 12), 4)] {
         let scene = setup.grid.build().unwrap();
         let settings = trained(4, false, ForceEvaluation::Exact);
         let cases = program(&scene, &setup.loads, &settings).unwrap();
@@ -182,7 +184,7 @@ fn the_training_program_covers_the_set_up_loads_scaled_and_tilted_and_the_announ
 
 #[test]
 fn a_training_range_out_of_bounds_is_refused() {
-    let setup = scenes::canonical("paper-2d-top-row").unwrap();
+    let setup = canonical_scenes::canonical("paper-2d-top-row").unwrap();
     let scene = setup.grid.build().unwrap();
     for (training, quantity) in [
         (TrainingProgram { scale: 1.0, ..TrainingProgram::default() }, Quantity::TrainingScale),

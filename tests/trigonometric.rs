@@ -9,6 +9,7 @@
 use crate::common;
 
 use common::*;
+use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::fmi::variables::vr;
 use modal_mass_spring::physics::error::StepFailure;
 use modal_mass_spring::physics::run::engine::{Engine, Probe, Stepper};
@@ -16,7 +17,6 @@ use modal_mass_spring::physics::run::frame::{Frame, Moments};
 use modal_mass_spring::physics::run::integrator::{Propagator, Trigonometric};
 use modal_mass_spring::physics::run::space::{Diagonal, Layout, Readout, Space};
 use modal_mass_spring::physics::*;
-use modal_mass_spring::scenes;
 
 // ---------------------------------------------------------------------------
 // The exact oscillator, by another road: exp(t M) of the augmented system
@@ -394,7 +394,7 @@ fn energy(sim: &mut Simulator) -> f64 {
 /// of the force, within bounds).
 #[test]
 fn no_blow_up_at_steps_where_a_mode_turns_by_a_multiple_of_pi() {
-    let setup = scenes::canonical("paper-2d-top-row").unwrap();
+    let setup = canonical_scenes::canonical("paper-2d-top-row").unwrap();
     let probe = setup.with_settings(load_static(modal(Integrator::Trigonometric, 16, 0.02))).simulator().unwrap();
     let omega = probe.mode_frequencies().to_vec();
     let pi = std::f64::consts::PI;
@@ -432,7 +432,7 @@ fn no_blow_up_at_steps_where_a_mode_turns_by_a_multiple_of_pi() {
 /// start, and by less than 2 % of the largest kinetic energy.
 #[test]
 fn the_energy_of_a_long_undamped_run_stays_bounded() {
-    let setup = scenes::canonical("paper-2d-top-row").unwrap();
+    let setup = canonical_scenes::canonical("paper-2d-top-row").unwrap();
     let mut sim = setup.with_settings(load_static(modal(Integrator::Trigonometric, 16, 0.02))).simulator().unwrap();
     let e0 = energy(&mut sim);
     let steps = 5000;
@@ -461,7 +461,7 @@ fn the_energy_of_a_long_undamped_run_stays_bounded() {
 #[test]
 fn a_step_too_long_for_the_stiffened_rest_of_the_force_is_refused() {
     let run = |dt: f64| {
-        let mut setup = scenes::canonical("paper-3d-sheet").unwrap().with_settings(modal(Integrator::Trigonometric, 58, dt));
+        let mut setup = canonical_scenes::canonical("paper-3d-sheet").unwrap().with_settings(modal(Integrator::Trigonometric, 58, dt));
         setup.loads.gravity = [0.0, -1e4, 0.0];
         setup.simulator().unwrap()
     };
@@ -513,7 +513,7 @@ fn motion(run: &[Vec<f64>], start: &[f64]) -> f64 {
 /// solution at a far smaller step, and the deleted mode stays at 0.
 #[test]
 fn agrees_with_explicit_newmark_at_small_steps() {
-    let setup = scenes::canonical("paper-2d-top-row").unwrap();
+    let setup = canonical_scenes::canonical("paper-2d-top-row").unwrap();
     let r = 8;
     let weights = [1.0, 0.5, 2.0, 1.0, 0.0, 1.0, 1.5, 1.0];
     let run = |integrator, dt: f64| {
@@ -558,7 +558,7 @@ fn agrees_with_explicit_newmark_at_small_steps() {
 /// and four times closer at half the step.
 #[test]
 fn every_option_with_a_moving_anchor_and_a_point_load() {
-    let setup = scenes::canonical("paper-2d-top-row").unwrap();
+    let setup = canonical_scenes::canonical("paper-2d-top-row").unwrap();
     let change = |k: usize, loads: &mut Loads| {
         let t = (k + 1) as f64 * 0.01;
         loads.anchor = [0.02 * (5.0 * t).sin(), 0.01 * (1.0 - (5.0 * t).cos()), 0.0];
@@ -646,7 +646,7 @@ fn fmi_state_resumes_bit_for_bit() {
 /// message that names both variables.
 #[test]
 fn refused_in_full_space() {
-    let setup = scenes::canonical("paper-2d-top-row").unwrap();
+    let setup = canonical_scenes::canonical("paper-2d-top-row").unwrap();
     let err = setup.with_settings(Settings::new(Reduction::Full, Integrator::Trigonometric, 0)).simulator().err();
     assert_eq!(err, Some(PhysicsError::SchemeNeedsDiagonal { scheme: Integrator::Trigonometric }));
     let f = Fmu::new();

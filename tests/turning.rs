@@ -12,11 +12,11 @@
 use crate::common;
 
 use common::*;
+use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::fmi::variables::vr;
 use modal_mass_spring::physics::run::forces::{SpringForces, SpringScratch, StiffnessPattern};
 use modal_mass_spring::physics::run::frame::{apply, apply_transposed, cross, dot, rotation};
 use modal_mass_spring::physics::*;
-use modal_mass_spring::scenes;
 use nalgebra::{DMatrix, DVector};
 
 fn settings(reduction: Reduction, integrator: Integrator, modes: usize) -> Settings {
@@ -25,7 +25,7 @@ fn settings(reduction: Reduction, integrator: Integrator, modes: usize) -> Setti
 
 /// The scene `name` with `solver`, gravity `gravity` and damping `alpha`.
 fn simulator(name: &str, solver: Settings, gravity: [f64; 3], alpha: f64) -> Simulator {
-    let mut setup = scenes::canonical(name).unwrap().with_settings(solver);
+    let mut setup = canonical_scenes::canonical(name).unwrap().with_settings(solver);
     setup.loads.gravity = gravity;
     setup.loads.damping_alpha = alpha;
     setup.simulator().unwrap()
@@ -284,7 +284,7 @@ fn the_turning_frame_agrees_with_a_ground_frame_integration_at_the_schemes_order
     let (h, steps) = (0.01, 50);
     let theta = |t: f64| [0.0, 0.0, 0.6 * (1.0 - (4.0 * t).cos())];
     let (g, alpha) = ([0.0, -9.81, 0.0], 0.5);
-    let scene = scenes::canonical("paper-2d-top-row").unwrap().grid.build().unwrap();
+    let scene = canonical_scenes::canonical("paper-2d-top-row").unwrap().grid.build().unwrap();
     let reference = ground_frame_reference(&scene, &theta, g, alpha, h, steps, 100);
     let mut errors = Vec::new();
     for dt in [2e-3, 1e-3, 5e-4] {
@@ -403,7 +403,7 @@ fn refusals_keep_the_state() {
     assert_eq!(sim.snapshot().state, before.state, "the refused step keeps the state");
     assert_eq!(sim.positions(), &positions[..]);
     // The trigonometric scheme takes a holder turned before the run and kept still, not a turning one.
-    let mut setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(settings(Reduction::Modal, Integrator::Trigonometric, 4));
+    let mut setup = canonical_scenes::canonical("paper-2d-top-row").unwrap().with_settings(settings(Reduction::Modal, Integrator::Trigonometric, 4));
     setup.loads.rotation = [0.0, 0.0, 0.3];
     let mut trig = setup.simulator().unwrap();
     trig.do_step(0.01).unwrap();
@@ -422,7 +422,7 @@ fn a_turned_holder_kept_still_carries_the_weight() {
         ("modal 2 lowest", settings(Reduction::Modal, Integrator::NewmarkExplicit, 2)),
         ("modal 4, trigonometric", settings(Reduction::Modal, Integrator::Trigonometric, 4)),
     ] {
-        let mut setup = scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
+        let mut setup = canonical_scenes::canonical("paper-2d-top-row").unwrap().with_settings(solver);
         setup.loads.rotation = [0.0, 0.0, 0.4];
         setup.loads.damping_alpha = 8.0;
         let mut sim = setup.simulator().unwrap();

@@ -24,7 +24,7 @@ mod run;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use modal_mass_spring::scenes;
+use modal_mass_spring::canonical_scenes;
 
 use measure::{measure_scene, Conditions};
 use plan::{plan_scene, variants, SceneCase, LARGE_DOFS};
@@ -80,10 +80,14 @@ fn main() {
     let budget_s = if quick { 5.0 } else { 10.0 };
     let variants = variants();
     let mut cases: Vec<SceneCase> = if quick {
-        ["paper-2d-top-row", "paper-3d-sheet"].into_iter().map(|n| SceneCase { label: n.into(), params: scenes::canonical(n).unwrap().grid }).collect()
+        ["paper-2d-top-row", "paper-3d-sheet"]
+            .into_iter()
+            .map(|n| SceneCase { label: n.into(), params: canonical_scenes::canonical(n).unwrap().grid })
+            .collect()
     } else {
-        let mut c: Vec<SceneCase> = scenes::names().into_iter().map(|n| SceneCase { label: n.into(), params: scenes::canonical(n).unwrap().grid }).collect();
-        c.push(SceneCase { label: "cloth-3d-100x100".into(), params: scenes::cloth(100, 100).grid });
+        let mut c: Vec<SceneCase> =
+            canonical_scenes::names().into_iter().map(|n| SceneCase { label: n.into(), params: canonical_scenes::canonical(n).unwrap().grid }).collect();
+        c.push(SceneCase { label: "cloth-3d-100x100".into(), params: canonical_scenes::cloth(100, 100).grid });
         c
     };
     if !only.is_empty() {

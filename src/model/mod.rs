@@ -4,18 +4,18 @@
 //! `modelDescription/variables.toml` mean to [`crate::physics`], and the
 //! model's own rules, behind the [`Model`] interface the glue calls.
 //!
-//! - [`params`]: values -> grid, solver settings, loads, load node, a twin's start; the canonical scenes;
+//! - [`to_physics`]: values -> grid, solver settings, loads, load node, a twin's start; the canonical scenes;
 //! - [`messages`]: physics errors as messages naming the variables;
 //! - [`bake`]: the baked set-up in `resources/setup.bin`;
-//! - [`snapshot`]: the simulator's part of a serialized FMU state;
+//! - [`state_bytes`]: the simulator's part of a serialized FMU state;
 //! - here: set-up, the Set rules (the load node's default column, its
 //!   check, loads passed to the running simulator), the outputs, the step
 //!   and when it warns about forceResidual.
 
 pub mod bake;
 pub mod messages;
-pub mod params;
-mod snapshot;
+mod state_bytes;
+pub mod to_physics;
 
 use std::path::Path;
 
@@ -286,11 +286,11 @@ impl Model for MassSpring {
     }
 
     fn write_snapshot(s: &Snapshot, out: &mut Vec<u8>) {
-        snapshot::write(s, out)
+        state_bytes::write(s, out)
     }
 
     fn read_snapshot(r: &mut Reader) -> Result<Snapshot, String> {
-        snapshot::read(r)
+        state_bytes::read(r)
     }
 
     fn check_snapshot(s: &Snapshot, p: &Params) -> Result<(), String> {
