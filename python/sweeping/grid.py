@@ -101,7 +101,7 @@ def parse_grid(md, params):
 def grid_points(axes):
     """Every combination of the axes' values, the last axis varying fastest."""
     names = [n for n, _ in axes]
-    return [dict(zip(names, combo)) for combo in itertools.product(*(v for _, v in axes))]
+    return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*(v for _, v in axes))]
 
 
 def experiment(md, stop_time=None, step=None):

@@ -4,7 +4,6 @@ anchors: the heading lowercased, punctuation but hyphens dropped, spaces as
 hyphens, repeated headings numbered)."""
 
 import re
-from pathlib import Path
 
 import pytest
 
