@@ -8,9 +8,9 @@ import os
 from .output import cell
 
 PLOTTED = [
-    ("finalSag", "final sag of the bottom row [m]"),
+    ("meanSag", "bottom row's sag, time-averaged over the run [m]"),
     ("maxKineticEnergy", "largest kinetic energy [J]"),
-    ("finalPotentialEnergy", "final potential energy [J]"),
+    ("maxSag", "bottom row's largest sag over the run [m]"),
     ("wallTime", "wall time of the run [s]"),
 ]
 

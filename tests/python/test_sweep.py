@@ -106,8 +106,30 @@ def test_each_run_has_its_own_parameters(sweeps):
         assert ok[200.0, m]["lowestFrequency"] / ok[50.0, m]["lowestFrequency"] == pytest.approx(2.0, rel=1e-9)
     # a stiffer sheet swings less; more modes, another trajectory
     assert ok[200.0, 2]["maxSag"] < ok[50.0, 2]["maxSag"]
-    assert ok[50.0, 4]["finalSag"] != ok[50.0, 2]["finalSag"]
+    assert ok[50.0, 4]["meanSag"] != ok[50.0, 2]["meanSag"]
 
+
+
+def test_plotted_sag_falls_with_stiffness(default_fmu, md):
+    """The sag the plot shows first, the bottom row's sag averaged over the
+    whole run, falls as the springs stiffen (50, 100, 200 N/m over the
+    default experiment, serially): the undamped sheet swings about its
+    equilibrium, and the average sits near the static sag. The sag at the
+    stop time catches each swing at another phase and need not fall."""
+    from sweeping.plot import PLOTTED
+
+    assert PLOTTED[0][0] == "meanSag"
+    rows = sweep.run_sweep(default_fmu, sweep.parse_grid(md, ["springStiffness=50,100,200"]), progress=False)
+    assert [r["status"] for r in rows] == ["ok"] * 3, [r["message"] for r in rows]
+    mean, settled, final = ([r[k] for r in rows] for k in ("meanSag", "settledSag", "finalSag"))
+    print(f"\nspringStiffness 50, 100, 200 N/m: meanSag {mean}, settledSag {settled}, finalSag {final}")
+    assert mean[0] > mean[1] > mean[2] > 0.0
+    assert settled[0] > settled[1] > settled[2] > 0.0
+    # as the static sag, about 1/k (measured 0.0562, 0.0286, 0.0140 m); released
+    # from rest the sheet swings to about twice it (maxSag)
+    assert mean[0] / mean[1] == pytest.approx(2.0, rel=0.1) and mean[1] / mean[2] == pytest.approx(2.0, rel=0.1)
+    for r in rows:
+        assert r["maxSag"] / r["meanSag"] == pytest.approx(2.0, rel=0.1)
 
 def test_refused_configurations_are_rows(sweeps, default_fmu, md, client):
     _, serial, on_cluster = sweeps
@@ -117,13 +139,13 @@ def test_refused_configurations_are_rows(sweeps, default_fmu, md, client):
         for r in refused:
             assert r["status"] == "error"
             assert "springStiffness" in r["message"] and "refused" in r["message"]
-            assert math.isnan(r["finalSag"]) and r["outputPoints"] == 0
+            assert math.isnan(r["meanSag"]) and math.isnan(r["finalSag"]) and r["outputPoints"] == 0
     # set-up refuses more modes than the scene has degrees of freedom (180), on a
     # worker too; the run beside it is not disturbed
     rows = sweep.run_sweep(default_fmu, sweep.parse_grid(md, ["nModes=500,2"]), stop_time=0.1, client=client, progress=False)
     assert [r["status"] for r in rows] == ["error", "ok"]
     assert "nModes = 500" in rows[0]["message"], rows[0]["message"]
-    assert rows[1]["outputPoints"] == 10 and np.isfinite(rows[1]["finalSag"])
+    assert rows[1]["outputPoints"] == 10 and np.isfinite(rows[1]["meanSag"])
 
 
 def read_csv(path):
