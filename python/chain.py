@@ -169,7 +169,7 @@ def run_master(fmu, h, stop, scheme="jacobi", anchor="relative", positions=False
         per_sheet = {s: [name[2:] for name in RECORDED if name[0] == s] for s in "AB"}
 
         def record(t):
-            values = {s: dict(zip(per_sheet[s], by_name[s].get(*per_sheet[s]))) for s in "AB"}
+            values = {s: dict(zip(per_sheet[s], by_name[s].get(*per_sheet[s]), strict=True)) for s in "AB"}
             rows.append([t] + [values[name[0]][name[2:]] for name in RECORDED])
             if positions:
                 frames.append([positions_of(by_name[s], s) for s in "AB"])

@@ -94,17 +94,17 @@ def filtered(v_cols, w_cols, drop):
     newest first, a column whose part orthogonal to those kept is shorter
     than drop times its length is left out. Returns (Q, R, W) of the kept."""
     q, r_rows, kept_w = [], [], []
-    for v, w in zip(v_cols, w_cols):
+    for v, w in zip(v_cols, w_cols, strict=True):
         if len(q) == len(v):
             break  # the kept columns span the interface: no further one is independent
         norm = np.linalg.norm(v)
         if norm == 0.0:
             continue
         coeffs = np.array([qi @ v for qi in q])
-        orth = v - sum((c * qi for c, qi in zip(coeffs, q)), np.zeros_like(v))
+        orth = v - sum((c * qi for c, qi in zip(coeffs, q, strict=True)), np.zeros_like(v))
         # second pass of Gram-Schmidt against cancellation
         corr = np.array([qi @ orth for qi in q])
-        orth = orth - sum((c * qi for c, qi in zip(corr, q)), np.zeros_like(v))
+        orth = orth - sum((c * qi for c, qi in zip(corr, q, strict=True)), np.zeros_like(v))
         length = np.linalg.norm(orth)
         if length < drop * norm:
             continue
@@ -229,7 +229,7 @@ def implicit_step(a, b, t, h, offset, acc, stats, tol=1e-10, max_iter=50, hold="
                 return i
             f = acc.next(f, value)
     finally:
-        for s, state in zip((a, b), states):
+        for s, state in zip((a, b), states, strict=True):
             s.slave.freeFMUState(state)
     raise NotConverged(
         f"the implicit chain ({acc.name}) did not converge in the step from t = {t:g} s by {h:g} s: "

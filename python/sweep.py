@@ -71,7 +71,8 @@ def main(argv=None):
         default=None,
         metavar="NAME=VALUE",
         help="start value of a reference run (repeatable, e.g. --reference reduction=full --reference maxInternalStep=1e-4): "
-        "every run gets E and maxNodeError against it (docs/method.md section 6), and the error plot shows E over the predictability window (--twins) against run time",
+        "every run gets E and maxNodeError against it (docs/method.md section 6), "
+        "and the error plot shows E over the predictability window (--twins) against run time",
     )
     p.add_argument(
         "--twins",
@@ -153,7 +154,8 @@ def main(argv=None):
     counts = {}
     for r in rows:
         counts[r["status"]] = counts.get(r["status"], 0) + 1
-    print(f"sweep: {len(rows)} runs in {wall:.2f} s ({', '.join(f'{c} {s}' for s, c in sorted(counts.items()))}); wrote {', '.join(os.path.relpath(w) for w in written)}")
+    statuses = ", ".join(f"{c} {s}" for s, c in sorted(counts.items()))
+    print(f"sweep: {len(rows)} runs in {wall:.2f} s ({statuses}); wrote {', '.join(os.path.relpath(w) for w in written)}")
     for r in rows:
         if r["status"] != "ok":
             print(f"  run {r['run']} ({', '.join(f'{k}={cell(r[k])}' for k, _ in axes)}): {r['status']}: {r['message']}")

@@ -115,14 +115,14 @@ for scene, rs in by_scene.items():
 # forceResidual against E, every scene.
 fig, axes = plt.subplots(1, 2, figsize=(13, 5.5))
 cmap = plt.get_cmap("tab10").colors
-for ax, column, name in zip(axes, ["force_residual_max", "force_residual_mean"], ["largest", "mean"]):
+for ax, column, name in zip(axes, ["force_residual_max", "force_residual_mean"], ["largest", "mean"], strict=True):
     xs, ys = [], []
     for i, (scene, rs) in enumerate(by_scene.items()):
         pts = [r for r in rs if leaves_out(r) and np.isfinite(f(r, column))]
         x, y = [f(p, column) for p in pts], [e(p) for p in pts]
         xs += x
         ys += y
-        ax.loglog([a for a in x if a > 0], [b for a, b in zip(x, y) if a > 0], "o", color=cmap[i % len(cmap)], alpha=0.6, markersize=4,
+        ax.loglog([a for a in x if a > 0], [b for a, b in zip(x, y, strict=True) if a > 0], "o", color=cmap[i % len(cmap)], alpha=0.6, markersize=4,
                   label=f"{scene} (ρ = {spearman(x, y):.2f}, {len(x)} runs)")
     ax.set_xlabel(f"{name} forceResidual over the run")
     ax.set_ylabel("trajectory error E over the window")

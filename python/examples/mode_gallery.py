@@ -88,7 +88,8 @@ def main(argv=None):
     for i in range(r):
         # each shape scaled so the node that moves most moves half a spacing
         moved = rest + 0.5 * spacing * shapes[i] / np.abs(shapes[i]).max()
-        kind = ("out-of-plane" if out_of_plane[i] > 0.5 else "in-plane") + (" symmetric" if symmetry[i] > 0.9 else " antisymmetric" if symmetry[i] < -0.9 else "")
+        parity = " symmetric" if symmetry[i] > 0.9 else " antisymmetric" if symmetry[i] < -0.9 else ""
+        kind = ("out-of-plane" if out_of_plane[i] > 0.5 else "in-plane") + parity
         for j, axes in enumerate(views):
             ax = axs[i // per_row, (i % per_row) * len(views) + j]
             ax.axis("on")

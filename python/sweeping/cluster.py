@@ -48,7 +48,7 @@ def run_on_cluster(client, data, digest, points, stop_time, step, progress, keep
         print()
     wait(futures)
     rows = []
-    for point, future in zip(points, futures):
+    for point, future in zip(points, futures, strict=True):
         try:
             rows.append(future.result())
         except Exception as e:  # a worker that died on this run, ...

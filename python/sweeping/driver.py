@@ -42,7 +42,7 @@ def compare(rows, n_twins):
     horizon, floor = measures.predictability(times, twins, HORIZON_THRESHOLD) if twins else (None, math.nan)
     last = times.index(horizon) if horizon is not None else len(times) - 1
     floor_window = max((float(w[last]) for w in twins), default=math.nan)
-    for row, w in zip(rows, windows):
+    for row, w in zip(rows, windows, strict=True):
         if w is None:
             row.update(E=math.nan, E_window=math.nan, maxNodeError=math.nan)
         else:

@@ -11,8 +11,14 @@ STEP = "step"
 METRICS = [
     "status",  # ok, warning (completed, the FMU warned), discard (a step was refused), error (refused)
     "finalTime",  # s, the time the run reached
-    "finalSag",  # m, how far the bottom row's mean y is below its rest position at finalTime
-    "maxSag",  # m, the largest of it over the output points
+    # The sag: how far the bottom row's mean y is below its rest position.
+    # Without damping the sheet swings about its equilibrium for the whole
+    # run, so the sag at one instant (finalSag) may be anywhere in a swing;
+    # its time averages sit near the static sag.
+    "meanSag",  # m, the sag averaged over time over the whole run (each output point weighted by its step)
+    "settledSag",  # m, the same average over the second half of the run
+    "maxSag",  # m, the largest sag at the output points
+    "finalSag",  # m, the sag at finalTime, one instant of the swing
     "maxKineticEnergy",  # J, over the output points
     "finalKineticEnergy",  # J
     "finalPotentialEnergy",  # J
@@ -101,7 +107,7 @@ def parse_grid(md, params):
 def grid_points(axes):
     """Every combination of the axes' values, the last axis varying fastest."""
     names = [n for n, _ in axes]
-    return [dict(zip(names, combo)) for combo in itertools.product(*(v for _, v in axes))]
+    return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*(v for _, v in axes))]
 
 
 def experiment(md, stop_time=None, step=None):

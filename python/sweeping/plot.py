@@ -8,9 +8,9 @@ import os
 from .output import cell
 
 PLOTTED = [
-    ("finalSag", "final sag of the bottom row [m]"),
+    ("meanSag", "bottom row's sag, time-averaged over the run [m]"),
     ("maxKineticEnergy", "largest kinetic energy [J]"),
-    ("finalPotentialEnergy", "final potential energy [J]"),
+    ("maxSag", "bottom row's largest sag over the run [m]"),
     ("wallTime", "wall time of the run [s]"),
 ]
 
@@ -25,7 +25,10 @@ def plot(path, rows, axes, title):
     import matplotlib.pyplot as plt
 
     varying = [(n, v) for n, v in axes if len(v) > 1]
-    is_number = lambda v: isinstance(v, (int, float)) and not isinstance(v, bool)
+
+    def is_number(v):
+        return isinstance(v, (int, float)) and not isinstance(v, bool)
+
     varying.sort(key=lambda axis: not all(is_number(v) for v in axis[1]))  # stable: numbers first
     if varying:
         xname, xvalues = varying[0]
@@ -43,10 +46,10 @@ def plot(path, rows, axes, title):
     for r in rows:
         series.setdefault(tuple(cell(r[n]) for n in others), []).append(r)
     fig, panels = plt.subplots(2, 2, figsize=(11, 7.5), sharex=True)
-    for ax, (metric, ylabel) in zip(panels.flat, PLOTTED):
+    for ax, (metric, ylabel) in zip(panels.flat, PLOTTED, strict=True):
         for key, rs in series.items():
             ok = sorted((r for r in rs if r["status"] in ("ok", "warning") and not math.isnan(r[metric])), key=xpos)
-            label = ", ".join(f"{n}={k}" for n, k in zip(others, key)) or None
+            label = ", ".join(f"{n}={k}" for n, k in zip(others, key, strict=True)) or None
             ax.plot([xpos(r) for r in ok], [r[metric] for r in ok], "o-", ms=4, label=label)
         ax.set_ylabel(ylabel)
         ax.grid(alpha=0.3)

@@ -17,6 +17,14 @@ import numpy as np
 
 from .grid import METRICS, STATUS_NAMES, STEP
 
+
+def time_average(times, values, start):
+    """The average of `values` over [start, times[-1]], each value (at the
+    end of its step) weighted by the step's length."""
+    steps = np.diff(np.concatenate(([start], times)))
+    return float((values * steps).sum() / steps.sum())
+
+
 def fmu_digest(data):
     return hashlib.sha256(data).hexdigest()[:16]
 
@@ -86,7 +94,7 @@ def run_one(fmu_data, digest, point, stop_time, step, keep_positions=False):
         def step_finished(t, recorder):
             if not state:  # first communication point: the sizes and the rest position
                 nx, ny, dim = (int(x) for x in fmu.getUInt64([vr["nx"], vr["ny"], vr["dimension"]]))
-                state.update(n=nx * ny * dim, nx=nx, dim=dim, rest=-(ny - 1) * fmu.getFloat64([vr["spacing"]])[0], sags=[])
+                state.update(n=nx * ny * dim, nx=nx, dim=dim, rest=-(ny - 1) * fmu.getFloat64([vr["spacing"]])[0], sags=[], sag_times=[])
                 state["omega0"] = fmu.getFloat64([vr["modeFrequencies"]], nValues=int(fmu.getUInt64([vr["nModes"]])[0]))[0]
             x = np.asarray(fmu.getFloat64([vr["positions"]], nValues=state["n"]))
             if keep_positions:
@@ -94,6 +102,7 @@ def run_one(fmu_data, digest, point, stop_time, step, keep_positions=False):
                 state.setdefault("times", []).append(float(t))
             bottom_y = x[-state["nx"] * state["dim"] :][1 :: state["dim"]]
             state["sags"].append(state["rest"] - bottom_y.mean())
+            state["sag_times"].append(float(t))
             return True
 
         res = simulate_fmu(
@@ -107,7 +116,9 @@ def run_one(fmu_data, digest, point, stop_time, step, keep_positions=False):
             model_description=md,
             fmu_instance=fmu,
         )
-        sags = np.array(state["sags"])
+        sags, sag_times, start = np.array(state["sags"]), np.array(state["sag_times"]), float(res["time"][0])
+        half = start + 0.5 * (sag_times[-1] - start)
+        second_half = sag_times > half
         if keep_positions:
             row["_positions"] = np.array(state["frames"])
             row["_times"] = state["times"]
@@ -115,8 +126,10 @@ def run_one(fmu_data, digest, point, stop_time, step, keep_positions=False):
             row["_dim"] = state["dim"]
         row.update(
             finalTime=float(res["time"][-1]),
-            finalSag=float(sags[-1]),
+            meanSag=time_average(sag_times, sags, start),
+            settledSag=time_average(sag_times[second_half], sags[second_half], half),
             maxSag=float(sags.max()),
+            finalSag=float(sags[-1]),
             maxKineticEnergy=float(res["kineticEnergy"].max()),
             finalKineticEnergy=float(res["kineticEnergy"][-1]),
             finalPotentialEnergy=float(res["potentialEnergy"][-1]),

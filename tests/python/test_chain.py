@@ -25,6 +25,7 @@ Jacobi needs h <= 1/256 s for the damping to win over the energy its
 one-step delay feeds in, and gains energy at h = 1/32 s.
 """
 
+import itertools
 import sys
 
 import numpy as np
@@ -83,7 +84,7 @@ def test_conventions_of_the_anchor_agree_to_round_off(runs):
     p0 = rel["A.restNode"]
     same = [n for n in STATE_OUTPUTS if not n.startswith(("B.loadNode", "B.potential"))] + ["A.potentialEnergy"]
     diffs = {n: np.abs(absolute[n] - rel[n]).max() for n in same}
-    for axis, offset in zip("XY", p0):
+    for axis, offset in zip("XY", p0, strict=True):
         diffs[f"B.loadNode{axis} - offset"] = np.abs(absolute[f"B.loadNode{axis}"] - offset - rel[f"B.loadNode{axis}"]).max()
     e_rel, e_abs = chain.total_energy(rel), chain.total_energy(absolute)
     diffs["energy - energy(0)"] = np.abs((e_abs - e_abs[0]) - e_rel).max()
@@ -159,8 +160,8 @@ def test_coupling_converges_with_the_communication_step(runs, scheme):
     Jacobi, the one-step-late anchor)."""
     ref = runs(scheme, FINE)
     errors = [coupling_error(runs(scheme, h), ref) for h in STEPS[scheme]]
-    print(f"\n{scheme}: error at h = " + ", ".join(f"{h:g} s: {e:.3e} m" for h, e in zip(STEPS[scheme], errors)))
-    ratios = [a / b for a, b in zip(errors, errors[1:])]
+    print(f"\n{scheme}: error at h = " + ", ".join(f"{h:g} s: {e:.3e} m" for h, e in zip(STEPS[scheme], errors, strict=True)))
+    ratios = [a / b for a, b in itertools.pairwise(errors)]
     # measured 2.09, 2.31 (Jacobi) and 2.04, 2.07 (Gauss-Seidel)
     assert all(r >= 1.6 for r in ratios), ratios
     assert errors[0] < 0.02
@@ -206,7 +207,7 @@ def test_energy_of_the_damped_pair_decays(runs, scheme):
         assert max(rises) <= 1e-12
     else:
         # measured 6.3e-6, 1.0e-6, 2.5e-7 J: a factor 4 to 6 per halving
-        assert all(a >= 2 * b for a, b in zip(rises, rises[1:])), rises
+        assert all(a >= 2 * b for a, b in itertools.pairwise(rises)), rises
         assert rises[-1] > 1e-12  # Jacobi does feed energy in
 
 
@@ -328,7 +329,7 @@ def test_implicit_chain_converges_to_the_explicit_chain_at_small_steps(stiff, sh
     lines, ratios = [], {}
     for hold in ("mean", "end"):
         errors = [coupling_error(stiff(sheets, "iqn-ils", h, hold=hold), limit) for h in IMPLICIT_STEPS]
-        ratios[hold] = [a / b for a, b in zip(errors, errors[1:])]
+        ratios[hold] = [a / b for a, b in itertools.pairwise(errors)]
         lines.append(f"hold {hold}: " + ", ".join(f"{e:.2e}" for e in errors) + " m; ratios "
                      + ", ".join(f"{q:.2f}" for q in ratios[hold]))
         if hold == "mean":
@@ -388,16 +389,17 @@ def test_accelerations_solve_a_linear_fixed_point(name):
     x_star = np.linalg.solve(np.eye(3) - G, c)
     acc = chain.coupling.accelerator(name)
     acc.start_step()
-    x = np.zeros(3)
-    for k in range(1, 200):
+    x, evaluations = np.zeros(3), 0
+    while evaluations < 199:
+        evaluations += 1
         value = G @ x + c
         if np.linalg.norm(value - x) <= 1e-12 * np.linalg.norm(value):
             break
         x = acc.next(x, value)
-    print(f"\n{name}: {k} evaluations, error {np.abs(x - x_star).max():.1e}")
+    print(f"\n{name}: {evaluations} evaluations, error {np.abs(x - x_star).max():.1e}")
     assert np.abs(x - x_star).max() < 1e-10
     if name == "iqn-ils":
-        assert k <= 5
+        assert evaluations <= 5
 
 
 def test_filter_drops_dependent_columns():

@@ -105,7 +105,9 @@ def test_the_command_writes_every_picture(default_fmu, tmp_path):
     numbers = (tmp_path / "numbers.txt").read_text()
     for name in ("fig7:", "fig8:", "fig9:", "3d:"):
         assert name in numbers
-    bad = subprocess.run([sys.executable, str(ROOT / "python" / "control.py"), default_fmu, "--figure", "fig10", "--out", str(tmp_path)], capture_output=True, text=True)
+    bad = subprocess.run(
+        [sys.executable, str(ROOT / "python" / "control.py"), default_fmu, "--figure", "fig10", "--out", str(tmp_path)], capture_output=True, text=True
+    )
     assert bad.returncode != 0 and "unknown figure fig10" in bad.stderr
 
 

@@ -1,10 +1,10 @@
 """Every relative link of the README and the docs leads somewhere: the file
 exists, and a #fragment names a heading of the page it points to (GitHub's
 anchors: the heading lowercased, punctuation but hyphens dropped, spaces as
-hyphens, repeated headings numbered)."""
+hyphens, repeated headings numbered). The README stays a short overview:
+at most README_MAX_LINES lines, the detail in docs/."""
 
 import re
-from pathlib import Path
 
 import pytest
 
@@ -12,6 +12,7 @@ from conftest import ROOT
 
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")), ROOT / "report" / "README.md", ROOT / "third_party" / "README.md"]
 LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)\)")
+README_MAX_LINES = 250
 
 
 def anchors(page):
@@ -46,3 +47,8 @@ def test_relative_links_resolve(page):
         elif fragment and target.suffix == ".md" and fragment not in anchors(target):
             broken.append(f"{link}: no heading #{fragment} in {target.relative_to(ROOT)}")
     assert not broken, "\n".join(broken)
+
+
+def test_readme_is_short():
+    lines = len((ROOT / "README.md").read_text().splitlines())
+    assert lines <= README_MAX_LINES, f"README.md has {lines} lines, more than {README_MAX_LINES}: move detail into docs/"

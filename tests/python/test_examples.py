@@ -48,10 +48,10 @@ def test_mode_gallery(default_fmu, tmp_path):
     png = tmp_path / "gallery.png"
     out = run("mode_gallery.py", default_fmu, "--out", str(png))
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    lines = [l for l in out.splitlines() if l.startswith("mode ")]
+    lines = [line for line in out.splitlines() if line.startswith("mode ")]
     assert len(lines) == 6
     # Gravity down and sideways in the plane loads in-plane modes of both parities.
-    assert all("out of plane 0.000" in l for l in lines)
-    assert any("symmetry +1.000" in l for l in lines) and any("symmetry -1.000" in l for l in lines)
+    assert all("out of plane 0.000" in line for line in lines)
+    assert any("symmetry +1.000" in line for line in lines) and any("symmetry -1.000" in line for line in lines)
     out = run("mode_gallery.py", default_fmu, "--dimension", "2", "--modes", "4", "--mode-selection", "lowest", "--out", str(png))
-    assert len([l for l in out.splitlines() if l.startswith("mode ")]) == 4
+    assert len([line for line in out.splitlines() if line.startswith("mode ")]) == 4

@@ -197,7 +197,7 @@ def test_state_file_continues_the_run(split_runs):
 
     uninterrupted, continued = communication_steps(0.0, STOP, H)[n:], communication_steps(SPLIT, STOP, H)
     assert len(uninterrupted) == len(continued)
-    same = next((k for k, (a, b) in enumerate(zip(uninterrupted, continued)) if a != b), len(continued))
+    same = next((k for k, (a, b) in enumerate(zip(uninterrupted, continued, strict=True)) if a != b), len(continued))
     assert second.rows[: same + 1] == full.rows[n : n + same + 1], f"the runs differ before the step sizes do (step {same} after t = {SPLIT})"
 
     for name in full.names:

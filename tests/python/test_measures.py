@@ -150,7 +150,10 @@ def test_error_shapes_and_zero():
     """Flattened rows and (time, ny, nx, D) arrays give the same numbers; the
     reference against itself has no error; mismatched shapes are refused."""
     run, reference, start = random_case(9, 20, 12, 3)
-    shaped = lambda a: a.reshape(len(a), 3, 4, 3)
+
+    def shaped(a):
+        return a.reshape(len(a), 3, 4, 3)
+
     assert trajectory_error(shaped(run), shaped(reference), start.reshape(3, 4, 3), 3) == trajectory_error(run, reference, start, 3)
     assert max_node_error(shaped(run), shaped(reference), 3) == max_node_error(run, reference, 3)
     assert trajectory_error(reference, reference, start, 3) == 0.0 and max_node_error(reference, reference, 3) == 0.0

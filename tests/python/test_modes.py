@@ -35,8 +35,8 @@ def fmu_modes(scene, n_modes, tmp):
 
 def markdown_rows(path):
     """The table rows of modes.md, as lists of cells."""
-    lines = [l for l in open(path).read().splitlines() if l.startswith("|")]
-    return [[c.strip() for c in l.strip("|").split("|")] for l in lines[2:]]
+    lines = [line for line in open(path).read().splitlines() if line.startswith("|")]
+    return [[c.strip() for c in line.strip("|").split("|")] for line in lines[2:]]
 
 
 @pytest.mark.skipif(not cargo_available(), reason="cargo is needed to run `cargo xtask modes`")
@@ -66,7 +66,7 @@ def test_gallery_matches_the_fmu(scene, n_modes, tmp_path):
     assert [row[5] for row in rows] == [t["class"] for t in table]
     # The classes read as the FMU's numbers say: out of the plane above one
     # half, symmetric / antisymmetric at +-0.9 or beyond, mixed between.
-    for row, out_of_plane, symmetry in zip(rows, fmu["modeOutOfPlane"], fmu["modeSymmetry"]):
+    for row, out_of_plane, symmetry in zip(rows, fmu["modeOutOfPlane"], fmu["modeSymmetry"], strict=True):
         plane, mirror = row[5].split()
         assert plane == ("out-of-plane" if out_of_plane > 0.5 else "in-plane"), row
         assert mirror == ("symmetric" if symmetry >= 0.9 else "antisymmetric" if symmetry <= -0.9 else "mixed"), row

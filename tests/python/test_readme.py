@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from fmpy import simulate_fmu
 
-from conftest import ROOT, cargo_available, fmu_path
+from conftest import ROOT, cargo_available
 
 README = (ROOT / "README.md").read_text()
 USAGE = (ROOT / "docs" / "usage.md").read_text()
@@ -35,7 +35,7 @@ def test_configuration_mode_snippet(default_fmu):
 
 
 def test_scene_baked_fmu_example(tmp_path):
-    line = next(l for l in USAGE.splitlines() if l.startswith("cargo xtask fmu --scene paper-2d-top-corners"))
+    line = next(u for u in USAGE.splitlines() if u.startswith("cargo xtask fmu --scene paper-2d-top-corners"))
     args = line.split()[3:]  # --scene paper-2d-top-corners --nx 12 --modes 5
     assert "target/fmu/paper-2d-top-corners-nx12-modes5.fmu" in USAGE
     out = tmp_path / "scene.fmu"
@@ -53,7 +53,7 @@ def test_chain_example(default_fmu, tmp_path):
     the pair hangs (nearly) still: B pulls on A with its weight."""
     m = re.search(r"## Two sheets in a chain.*?```sh\n(.*?)```", README, re.S)
     assert m, "chain command not found in README.md"
-    line = next(l for l in m.group(1).splitlines() if "python/chain.py" in l)
+    line = next(c for c in m.group(1).splitlines() if "python/chain.py" in c)
     cmd = line.split("#")[0].split()
     assert cmd[0] == ".venv/bin/python" and cmd[1] == "python/chain.py"
     assert "docs/chain.png" in README and (ROOT / "docs" / "chain.png").exists()

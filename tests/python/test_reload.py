@@ -9,8 +9,6 @@ working; a pointer it does not know is refused with a line on stderr,
 since no instance means no logger. Reproduced here with ctypes alone.
 """
 
-import ctypes
-import _ctypes
 import subprocess
 import sys
 import textwrap

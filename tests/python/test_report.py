@@ -67,9 +67,9 @@ def reference_table(folder):
     """The References table of the report's README, a dict of cells per scene."""
     text = (folder / "README.md").read_text()
     table = text.split("## References", 1)[1].split("\n## ", 1)[0]
-    lines = [l for l in table.splitlines() if l.startswith("| ") and not l.startswith("| scene")]
+    lines = [line for line in table.splitlines() if line.startswith("| ") and not line.startswith("| scene")]
     keys = ["scene", "dofs", "dt", "self", "halved", "smallest", "ratio", "resolved_until", "self_there", "smallest_there", "ratio_there"]
-    return {cells[0]: dict(zip(keys, cells)) for cells in ([c.strip() for c in l.strip("|").split("|")] for l in lines)}
+    return {cells[0]: dict(zip(keys, cells, strict=True)) for cells in ([c.strip() for c in line.strip("|").split("|")] for line in lines)}
 
 
 def sensitive(reference):

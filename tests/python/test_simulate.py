@@ -152,7 +152,10 @@ def test_basis_options_through_fmpy(default_fmu):
     and two modes chosen by the load at the equilibrium follow full space
     more closely than the paper's two lowest modes at rest."""
     outputs = ["positions", "modeFrequencies"]
-    run = lambda **starts: simulate_fmu(default_fmu, stop_time=2.0, output_interval=0.05, output=outputs, start_values=starts)
+
+    def run(**starts):
+        return simulate_fmu(default_fmu, stop_time=2.0, output_interval=0.05, output=outputs, start_values=starts)
+
     full = run(reduction=2)
     sway = full["modeFrequencies"][0][0]
     lowest = run()
@@ -173,7 +176,12 @@ def test_cubature_through_fmpy(default_fmu):
     basis with exact forces closely, and cubatureSprings says how few
     springs it visits (every spring with exact forces)."""
     outputs = ["positions", "cubatureSprings"]
-    run = lambda **starts: simulate_fmu(default_fmu, stop_time=2.0, output_interval=0.05, output=outputs, start_values=dict(modeSelection=2, staticCorrection=True, **starts))
+
+    def run(**starts):
+        return simulate_fmu(
+            default_fmu, stop_time=2.0, output_interval=0.05, output=outputs, start_values=dict(modeSelection=2, staticCorrection=True, **starts)
+        )
+
     exact = run()
     cubature = run(forceEvaluation=2, cubatureTolerance=0.002)
     springs_all, springs_kept = int(exact["cubatureSprings"][0]), int(cubature["cubatureSprings"][0])

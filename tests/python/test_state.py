@@ -34,13 +34,13 @@ def history(inst, steps, h=H):
 
 def assert_same(a, b):
     assert len(a) == len(b)
-    for sa, sb in zip(a, b):
+    for sa, sb in zip(a, b, strict=True):
         for k in sa:
             assert np.array_equal(sa[k], sb[k]), k  # bit for bit
 
 
 def assert_differs(a, b):
-    assert any(not np.array_equal(sa["positions"], sb["positions"]) for sa, sb in zip(a, b))
+    assert any(not np.array_equal(sa["positions"], sb["positions"]) for sa, sb in zip(a, b, strict=True))
 
 
 def test_get_set_state_same_instance(new_instance):

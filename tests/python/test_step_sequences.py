@@ -20,6 +20,7 @@ trajectory to round-off, with the same input signals; a step whose count
 does change shows how far that would move it.
 """
 
+import itertools
 from math import isclose
 
 import numpy as np
@@ -179,10 +180,10 @@ def test_fmpy_sequence_is_what_simulate_fmu_sends(default_fmu):
     for start in (0.0, 1000.0):
         times = []
         simulate_fmu(default_fmu, start_time=start, stop_time=start + STOP, output_interval=0.01, output=["kineticEnergy"],
-                     step_finished=lambda t, recorder: times.append(t) or True)
+                     step_finished=lambda t, recorder, times=times: times.append(t) or True)
         replica = fmpy_sequence(start, start + STOP, 0.01)
         assert times == [t + h for t, h in replica]
-        assert [b - a for a, b in zip([start] + times, times)] == [h for _, h in replica]
+        assert [b - a for a, b in itertools.pairwise([start] + times)] == [h for _, h in replica]
 
 
 def test_container_sends_multiples_of_its_fixed_step(tmp_path):
@@ -209,6 +210,6 @@ def test_container_sends_multiples_of_its_fixed_step(tmp_path):
     times = []
     simulate_fmu(str(path), stop_time=STOP, output_interval=0.01, debug_logging=True, logger=logger, output=["A.loadNodeY"],
                  step_finished=lambda t, recorder: times.append(t) or True)
-    sent = [b - a for a, b in zip([0.0] + times, times)]
+    sent = [b - a for a, b in itertools.pairwise([0.0] + times)]
     assert any(h != 0.01 for h in sent)  # simulate_fmu's steps to the container
     assert calls == container_sequence(0.0, STOP, 0.01)

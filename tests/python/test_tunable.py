@@ -87,7 +87,8 @@ def test_weights_as_string_start_value(default_fmu):
 
 
 def test_wrong_number_of_weights_is_refused(default_fmu):
-    with pytest.raises(Exception):
+    # fmpy checks the length against the array's dimension (nModes = 2)
+    with pytest.raises(Exception, match='"modeWeights" must have 2 elements but has 3'):
         run(default_fmu, modeWeights=[1.0, 1.0, 1.0])
 
 

@@ -5,7 +5,6 @@ import subprocess
 import sys
 import zipfile
 
-import pytest
 from fmpy import read_model_description
 from fmpy.validation import validate_fmu
 

@@ -13,6 +13,7 @@ mod docs;
 mod fmu;
 mod fmusim;
 mod fuzz;
+mod lint;
 mod modes;
 mod report;
 mod run;

@@ -7,7 +7,8 @@
 //!   (the paper's control experiments and control in 3D through the FMU).
 //! - `test [--only STAGE[,STAGE...]] [PYTEST ARGS...]`: setup, build the
 //!   default FMU and one scene-baked FMU per canonical scene into
-//!   `target/fmu/`, `cargo fmt --check`, each fuzz target for FUZZ_SECONDS,
+//!   `target/fmu/`, `cargo fmt --check`, the Python lint (ruff with
+//!   `ruff.toml`, no Python file over 600 lines), each fuzz target for FUZZ_SECONDS,
 //!   `cargo test --release --workspace` (with the XSD validation of the model
 //!   description and the soak run of a million steps), the quick study, the
 //!   reference importer fmusim (`target/tools/fmusim`), pytest on
@@ -21,7 +22,7 @@ use std::time::Instant;
 
 use crate::cli::{self, Long, ValueExt};
 use crate::setup::{cargo, target_dir};
-use crate::{fmu, fmusim, fuzz, setup, valgrind};
+use crate::{fmu, fmusim, fuzz, lint, setup, valgrind};
 
 /// Packages and features of every cargo build of the test stage: the same
 /// for the tests, the quick study and the valgrind example, so each builds
@@ -143,6 +144,8 @@ Every stage, in this order (CI runs them all):
   setup     cargo xtask setup (what the tests need)
   fmu       the default FMU and one FMU per canonical scene, into target/fmu/
   fmt       cargo fmt --check
+  lint      ruff check of every Python file (ruff.toml), none over 600 lines
+            (installs ruff into .venv when missing)
   fuzz      each fuzz target for 30 s
   rust      cargo test --release --workspace --features xsd
   report    cargo xtask report --quick, into target/report-quick/
@@ -161,6 +164,7 @@ enum Stage {
     Setup,
     Fmu,
     Fmt,
+    Lint,
     Fuzz,
     Rust,
     Report,
@@ -169,10 +173,11 @@ enum Stage {
     Valgrind,
 }
 
-const STAGES: [(&str, Stage); 9] = [
+const STAGES: [(&str, Stage); 10] = [
     ("setup", Stage::Setup),
     ("fmu", Stage::Fmu),
     ("fmt", Stage::Fmt),
+    ("lint", Stage::Lint),
     ("fuzz", Stage::Fuzz),
     ("rust", Stage::Rust),
     ("report", Stage::Report),
@@ -276,6 +281,14 @@ pub fn test(args: &[String]) -> Result<(), String> {
         lap("fmt", &mut times);
     }
 
+    if selected(Stage::Lint) {
+        step(&format!("lint: ruff check (ruff.toml), Python files at most {} lines", lint::MAX_PYTHON_LINES));
+        if let Err(e) = lint::run(&root) {
+            failures.push(format!("lint: {e}"));
+        }
+        lap("lint", &mut times);
+    }
+
     // Right after the FMU build: the fuzz targets load its library as it is
     // (the test build below compiles the crate with other features).
     if selected(Stage::Fuzz) {
@@ -370,7 +383,7 @@ pub fn test(args: &[String]) -> Result<(), String> {
         eprintln!("\npassed: {} (--only)", names.join(", "));
         Ok(())
     } else {
-        eprintln!("\nall tests passed (cargo test, pytest with fmpy and fmusim, valgrind, fuzzing)");
+        eprintln!("\nall tests passed (cargo test, pytest with fmpy and fmusim, valgrind, fuzzing, the Python lint)");
         Ok(())
     }
 }

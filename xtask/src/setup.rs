@@ -14,7 +14,8 @@
 //!   (`cargo xtask sweep`, python/sweep.py); for the tests pytest and
 //!   fmu-manipulation-toolbox (its `fmucontainer` is one of the co-simulation
 //!   masters `tests/python/test_chain.py` runs the FMU under) and ecospy
-//!   (the Ecos co-simulation engine, `tests/python/test_ecos.py`).
+//!   (the Ecos co-simulation engine, `tests/python/test_ecos.py`); ruff,
+//!   the Python linter of the `lint` stage (xtask/src/lint.rs).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -60,6 +61,8 @@ const PYTHON_PACKAGES: &[(&str, &str, Purpose)] = &[
     ("pytest", "pytest", Purpose::Test),
     ("fmu_manipulation_toolbox", "fmu_manipulation_toolbox==2.0", Purpose::Test),
     ("ecospy", "ecospy==0.7.2", Purpose::Test),
+    // the rules it checks change between versions: pinned, like a toolchain
+    ("ruff", "ruff==0.17.6", Purpose::Test),
 ];
 
 pub fn root() -> PathBuf {
@@ -230,11 +233,22 @@ fn installed_version(dist: &str) -> Option<String> {
 }
 
 fn python_packages(purpose: Purpose) -> Result<(), String> {
+    pip_install_missing(PYTHON_PACKAGES.iter().filter(|(_, _, needed_from)| purpose >= *needed_from))
+}
+
+/// The venv (made when missing) with the packages `dists` of
+/// [`PYTHON_PACKAGES`] (installed when missing): what one stage of the tests
+/// needs when `--only` leaves the setup out.
+pub fn python_tools(dists: &[&str]) -> Result<(), String> {
+    venv()?;
+    pip_install_missing(PYTHON_PACKAGES.iter().filter(|(dist, _, _)| dists.contains(dist)))
+}
+
+/// `pip install` of those of `packages` that are missing or at another
+/// version than their pin.
+fn pip_install_missing<'a>(packages: impl Iterator<Item = &'a (&'a str, &'a str, Purpose)>) -> Result<(), String> {
     let mut missing = Vec::new();
-    for (dist, req, needed_from) in PYTHON_PACKAGES {
-        if purpose < *needed_from {
-            continue;
-        }
+    for (dist, req, _) in packages {
         let pinned = req.split_once("==").map(|(_, v)| v);
         match installed_version(dist) {
             Some(v) if pinned.is_none_or(|p| v == p) => {}
