@@ -156,8 +156,21 @@ struct Linear {
 }
 
 struct LinearWork {
+    loads: Loads,
     damping: Vec<f64>,
     load: Vec<f64>,
+}
+
+impl AsRef<Loads> for LinearWork {
+    fn as_ref(&self) -> &Loads {
+        &self.loads
+    }
+}
+
+impl AsMut<Loads> for LinearWork {
+    fn as_mut(&mut self) -> &mut Loads {
+        &mut self.loads
+    }
 }
 
 impl Linear {
@@ -182,19 +195,19 @@ impl Space for Linear {
         let n = self.lambda.len();
         Layout { scene: &self.scene, coordinates: n, kept_modes: Some(n), springs: 0, frequencies: &self.frequencies, trained: None, newton_scale: 1.0 }
     }
-    fn work(&self) -> LinearWork {
-        LinearWork { damping: vec![0.0; self.lambda.len()], load: vec![0.0; self.lambda.len()] }
+    fn work(&self, loads: &Loads) -> LinearWork {
+        LinearWork { loads: loads.clone(), damping: vec![0.0; self.lambda.len()], load: vec![0.0; self.lambda.len()] }
     }
     fn rest_coordinates(&self, y: &mut [f64]) {
         y.fill(0.0);
     }
-    fn apply_loads(&self, loads: &Loads, w: &mut LinearWork) {
+    fn apply_loads(&self, w: &mut LinearWork) {
         for i in 0..self.lambda.len() {
-            w.damping[i] = loads.damping_alpha + loads.damping_beta * self.lambda[i];
-            w.load[i] = loads.mode_weights[i] * self.load[i];
+            w.damping[i] = w.loads.damping_alpha + w.loads.damping_beta * self.lambda[i];
+            w.load[i] = w.loads.mode_weights[i] * self.load[i];
         }
     }
-    fn force(&self, _loads: &Loads, y: &[f64], w: &mut LinearWork, h: &mut [f64]) {
+    fn force(&self, y: &[f64], w: &mut LinearWork, h: &mut [f64]) {
         self.evaluations.set(self.evaluations.get() + 1);
         for i in 0..y.len() {
             h[i] = w.load[i] - self.lambda[i] * y[i];
@@ -211,21 +224,21 @@ impl Space for Linear {
     fn residual(&self, _v: &[f64], _a: &[f64], _h: &[f64], _w: &mut LinearWork, _r: &mut [f64]) {
         unreachable!("the trigonometric scheme only")
     }
-    fn factor(&self, _loads: &Loads, _c_m: f64, _c_c: f64, _w: &mut LinearWork) -> Result<(), StepFailure> {
+    fn factor(&self, _c_m: f64, _c_c: f64, _w: &mut LinearWork) -> Result<(), StepFailure> {
         unreachable!("the trigonometric scheme only")
     }
     fn solve(&self, _w: &mut LinearWork, _rhs: &mut [f64]) {
         unreachable!("the trigonometric scheme only")
     }
-    fn omega_sq_bound(&self, _loads: &Loads) -> f64 {
+    fn omega_sq_bound(&self, _w: &LinearWork) -> f64 {
         self.lambda.iter().fold(0.0, |m, &l| m.max(l))
     }
     fn diagonal<'a>(&'a self, w: &'a LinearWork) -> Option<Diagonal<'a>> {
         Some(Diagonal { stiffness: &self.lambda, damping: &w.damping, load: &w.load })
     }
-    fn add_translation_rate(&self, _loads: &Loads, _c: &[f64; 3], _v: &mut [f64]) {}
-    fn add_rotation_rate(&self, _loads: &Loads, _c: &[f64; 3], _y: &[f64], _v: &mut [f64]) {}
-    fn turn(&self, _loads: &Loads, _frame: &Frame, _w: &mut LinearWork) {}
+    fn add_translation_rate(&self, _w: &LinearWork, _c: &[f64; 3], _v: &mut [f64]) {}
+    fn add_rotation_rate(&self, _w: &LinearWork, _c: &[f64; 3], _y: &[f64], _v: &mut [f64]) {}
+    fn turn(&self, _frame: &Frame, _w: &mut LinearWork) {}
 }
 
 impl Readout for Linear {
@@ -243,7 +256,7 @@ impl Readout for Linear {
     fn elastic_energy(&self, y: &[f64], _w: &mut LinearWork) -> f64 {
         y.iter().zip(&self.lambda).map(|(y, l)| 0.5 * l * y * y).sum()
     }
-    fn gravity_potential(&self, _loads: &Loads, y: &[f64], w: &LinearWork) -> f64 {
+    fn gravity_potential(&self, y: &[f64], w: &LinearWork) -> f64 {
         -y.iter().zip(&w.load).map(|(y, b)| y * b).sum::<f64>()
     }
     fn kinetic_energy(&self, v: &[f64]) -> f64 {
@@ -262,7 +275,7 @@ impl Readout for Linear {
     fn modal_coordinates(&self, y: &[f64], out: &mut [f64]) {
         out.copy_from_slice(y);
     }
-    fn force_residual(&self, _loads: &Loads, _y: &[f64], _w: &mut LinearWork) -> f64 {
+    fn force_residual(&self, _gravity: &[f64; 3], _point: &[f64; 3], _y: &[f64], _w: &mut LinearWork) -> f64 {
         0.0
     }
 }
@@ -278,15 +291,15 @@ fn linear_loads(alpha: f64, beta: f64, weights: &[f64]) -> Loads {
 /// `steps` steps of `dt` of the linear space from (y0, v0), after a settle
 /// as at the start of a run; (y, v) after each step.
 fn linear_run(loads: &Loads, y0: &[f64], v0: &[f64], dt: f64, steps: usize) -> Vec<(Vec<f64>, Vec<f64>)> {
-    let mut engine = Engine::<Linear, Trigonometric>::new(Linear::new(&LAMBDA, &LOAD)).unwrap();
-    engine.apply_loads(loads);
+    let mut engine = Engine::<Linear, Trigonometric>::new(Linear::new(&LAMBDA, &LOAD), loads).unwrap();
+    engine.apply_loads();
     let mut state = State::at_rest(LAMBDA.len());
     state.y.copy_from_slice(y0);
     state.v.copy_from_slice(v0);
-    engine.settle(loads, &mut state);
+    engine.settle(&mut state);
     let mut out = Vec::new();
     for _ in 0..steps {
-        engine.step(loads, &mut state, dt).unwrap();
+        engine.step(&mut state, dt).unwrap();
         out.push((state.y.clone(), state.v.clone()));
     }
     out
@@ -665,20 +678,20 @@ fn refused_in_full_space() {
 #[test]
 fn one_force_evaluation_per_step_until_an_output_needs_the_forces() {
     let loads = linear_loads(0.5, 1e-3, &[1.0; 5]);
-    let mut engine = Engine::<Linear, Trigonometric>::new(Linear::new(&LAMBDA, &LOAD)).unwrap();
-    engine.apply_loads(&loads);
+    let mut engine = Engine::<Linear, Trigonometric>::new(Linear::new(&LAMBDA, &LOAD), &loads).unwrap();
+    engine.apply_loads();
     let mut state = State::at_rest(LAMBDA.len());
-    engine.settle(&loads, &mut state);
-    engine.step(&loads, &mut state, 0.01).unwrap();
+    engine.settle(&mut state);
+    engine.step(&mut state, 0.01).unwrap();
     let count = |e: &Engine<Linear, Trigonometric>| e.space().evaluations.get();
     let start = count(&engine);
     for _ in 0..10 {
-        engine.step(&loads, &mut state, 0.01).unwrap();
-        assert!(engine.model_energy(&loads, &state).is_finite());
+        engine.step(&mut state, 0.01).unwrap();
+        assert!(engine.model_energy(&state).is_finite());
     }
     assert_eq!(count(&engine) - start, 10, "one evaluation per step, none for the guard");
-    let e1 = engine.potential_energy(&loads, &state);
+    let e1 = engine.potential_energy(&state);
     assert_eq!(count(&engine) - start, 11, "the potential energy evaluates the forces at the state");
-    let e2 = engine.potential_energy(&loads, &state);
+    let e2 = engine.potential_energy(&state);
     assert_eq!((count(&engine) - start, e1), (11, e2), "and only once");
 }

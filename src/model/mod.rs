@@ -23,7 +23,7 @@ use crate::bytes::Reader;
 use crate::fmi::logging::Logger;
 use crate::fmi::model::{Computed, Model, StepEnd};
 use crate::fmi::variables::{index_of, vr, Causality, VARIABLES};
-use crate::physics::{Loads, ModeClasses, Simulator, Snapshot};
+use crate::physics::{ModeClasses, Simulator, Snapshot};
 use crate::status::{OK, WARNING};
 
 pub use crate::fmi::params::Params;
@@ -47,9 +47,6 @@ pub struct MassSpring {
     range_warned: bool,
     /// The host set loadColumn; until then it follows the middle of the row (nx / 2).
     load_column_chosen: bool,
-    /// Scratch for the loads handed to the simulator, filled in place and
-    /// sized at set-up: a change in Step Mode allocates nothing.
-    loads: Loads,
     /// The springs between nodes (see [`MassSpring::spring_neighbours`]), made when first read.
     springs: Option<Vec<f64>>,
     /// modeOutOfPlane and modeSymmetry, made when first read.
@@ -72,7 +69,6 @@ impl Model for MassSpring {
             residual_gap: 1,
             range_warned: false,
             load_column_chosen: false,
-            loads: Params::start().loads(),
             springs: None,
             classes: None,
             shapes: None,
@@ -117,7 +113,7 @@ impl Model for MassSpring {
         match built {
             Ok(sim) => {
                 log.log(OK, &format!("simulator set up: {} nodes in {}D, {} modes", sim.scene().n_nodes, sim.scene().dim, sim.mode_frequencies().len()));
-                self.installed(sim, p);
+                self.installed(sim);
                 Ok(())
             }
             Err(e) => Err(format!("cannot set up the simulator: {}", messages::describe(&e, p))),
@@ -146,9 +142,9 @@ impl Model for MassSpring {
         self.load_column_chosen |= chooses_column;
         if running {
             // Only tunables and inputs get here; they act from the next step on.
-            p.fill_loads(&mut self.loads);
             let sim = self.sim.as_mut().expect("Step Mode has a simulator");
-            sim.set_loads(&self.loads).map_err(|e| messages::describe(&e, p))?;
+            // Written where the physics reads them, all or nothing.
+            sim.edit_loads(|loads| p.fill_loads(loads)).map_err(|e| messages::describe(&e, p))?;
             // New parameters (gravity turned sideways, weights, damping) are checked after the
             // next step; the inputs a master sets every step (the point load, the holder) are not,
             // or the check would run after every step of a coupled run.
@@ -276,7 +272,7 @@ impl Model for MassSpring {
             return Err("the state gives non-finite outputs (positions, velocities or energies)".into());
         }
         if let Some(sim) = sim {
-            self.installed(sim, p);
+            self.installed(sim);
         }
         self.stale = false;
         // A restored state is checked after the next step.
@@ -323,10 +319,8 @@ pub fn residual_period(sim: &Simulator) -> u64 {
 }
 
 impl MassSpring {
-    /// Makes `sim`, set up from `p`, the current simulator (and sizes the
-    /// loads' scratch for it).
-    fn installed(&mut self, sim: Simulator, p: &Params) {
-        p.fill_loads(&mut self.loads);
+    /// Makes `sim`, set up from `p`, the current simulator.
+    fn installed(&mut self, sim: Simulator) {
         self.sim = Some(sim);
         self.stale = false;
         self.springs = None;

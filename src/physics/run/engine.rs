@@ -39,7 +39,7 @@ pub(crate) fn build(scene: Scene, settings: &Settings, loads: &Loads, prebuilt: 
     };
     match settings.reduction {
         Reduction::Modal => match settings.force_evaluation {
-            ForceEvaluation::Exact => bind(Modal::<Exact>::new(scene, loads, settings, prebuilt)?, settings.integrator),
+            ForceEvaluation::Exact => bind(Modal::<Exact>::new(scene, loads, settings, prebuilt)?, settings.integrator, loads),
             ForceEvaluation::Cubature => {
                 // The spring set is trained on the exact reduced model unless it is stored.
                 let trained;
@@ -50,19 +50,19 @@ pub(crate) fn build(scene: Scene, settings: &Settings, loads: &Loads, prebuilt: 
                         Some(&trained)
                     }
                 };
-                bind(Modal::<Cubature>::new(scene, loads, settings, prebuilt)?, settings.integrator)
+                bind(Modal::<Cubature>::new(scene, loads, settings, prebuilt)?, settings.integrator, loads)
             }
         },
-        Reduction::Full => bind(Full::new(scene, loads, settings)?, settings.integrator),
+        Reduction::Full => bind(Full::new(scene, loads, settings)?, settings.integrator, loads),
     }
 }
 
 /// Binds `space` to the scheme `kind` names.
-fn bind<S: Readout>(space: S, kind: Integrator) -> Result<Box<dyn Stepper>, PhysicsError> {
+fn bind<S: Readout>(space: S, kind: Integrator, loads: &Loads) -> Result<Box<dyn Stepper>, PhysicsError> {
     Ok(match kind {
-        Integrator::NewmarkExplicit => Box::new(Engine::<S, NewmarkExplicit>::new(space)?),
-        Integrator::NewmarkImplicit => Box::new(Engine::<S, NewmarkImplicit>::new(space)?),
-        Integrator::Trigonometric => Box::new(Engine::<S, Trigonometric>::new(space)?),
+        Integrator::NewmarkExplicit => Box::new(Engine::<S, NewmarkExplicit>::new(space, loads)?),
+        Integrator::NewmarkImplicit => Box::new(Engine::<S, NewmarkImplicit>::new(space, loads)?),
+        Integrator::Trigonometric => Box::new(Engine::<S, Trigonometric>::new(space, loads)?),
     })
 }
 
@@ -76,32 +76,36 @@ pub trait Stepper: Probe + Send {
     fn setup_data(&self) -> Option<SetupData>;
     /// The kept (modal) or reported (full) modes, if any.
     fn modes(&self) -> Option<&ModalBasis>;
-    /// Longest stable internal step under `loads`, if stability limits it.
-    fn stable_step(&self, loads: &Loads) -> Option<f64>;
-    /// Squared-frequency bound of the integrated system under `loads` [1/s^2].
-    fn omega_sq_bound(&self, loads: &Loads) -> f64;
-    /// Derives the load terms of the space from `loads`.
-    fn apply_loads(&mut self, loads: &Loads);
+    /// The loads of the run: the one place they live (in the space's work).
+    fn loads(&self) -> &Loads;
+    /// The loads, to change in place; [`Stepper::apply_loads`] then derives their terms.
+    fn loads_mut(&mut self) -> &mut Loads;
+    /// Longest stable internal step under the loads, if stability limits it.
+    fn stable_step(&self) -> Option<f64>;
+    /// Squared-frequency bound of the integrated system under the loads [1/s^2].
+    fn omega_sq_bound(&self) -> f64;
+    /// Derives the load terms of the space from the loads.
+    fn apply_loads(&mut self);
     /// The coordinates of the scene at rest.
     fn rest_coordinates(&self, y: &mut [f64]);
     /// Evaluates the forces at `state.y` (positions and elastic energy
     /// follow it) and sets `state.a` as the scheme needs it (see
     /// [`Scheme::settle`]): at the start, and after a change of loads, which
     /// then acts as a step input.
-    fn settle(&mut self, loads: &Loads, state: &mut State);
+    fn settle(&mut self, state: &mut State);
     /// Evaluates the forces at `state.y` only (after a restore, which
     /// brings its own accelerations).
-    fn evaluate(&mut self, loads: &Loads, state: &State);
+    fn evaluate(&mut self, state: &State);
     /// One internal step of length `dt`.
-    fn step(&mut self, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure>;
+    fn step(&mut self, state: &mut State, dt: f64) -> Result<(), StepFailure>;
     /// Adds the rates of a rigid translation with velocity `c` and of a
     /// rigid rotation about the pivot with angular velocity `spin` to
     /// `state.v` (see [`Space::add_translation_rate`],
     /// [`Space::add_rotation_rate`]) and sets `state.a` for the new rates
     /// (see [`Scheme::settle_rates`]).
-    fn kick(&mut self, loads: &Loads, c: &[f64; 3], spin: &[f64; 3], state: &mut State);
+    fn kick(&mut self, c: &[f64; 3], spin: &[f64; 3], state: &mut State);
     /// The holder's frame for what follows (see [`Space::turn`]).
-    fn turn(&mut self, loads: &Loads, frame: &Frame);
+    fn turn(&mut self, frame: &Frame);
     /// The scheme can integrate a turning holder (see [`Scheme::TURNS`]).
     fn turns(&self) -> bool;
 }
@@ -111,7 +115,7 @@ pub trait Stepper: Probe + Send {
 pub trait Probe {
     /// The spring force at `y` in the space's coordinates (see
     /// [`Readout::spring_force`]); the forces at `state.y` are evaluated again after.
-    fn spring_force(&mut self, loads: &Loads, state: &State, y: &[f64], out: &mut [f64]);
+    fn spring_force(&mut self, state: &State, y: &[f64], out: &mut [f64]);
     /// Momentum of the free nodes per axis, relative to the anchor [kg m/s].
     fn momentum(&self, state: &State) -> [f64; 3];
     /// The mass moments of the rates at `state` (see [`Readout::moments`]).
@@ -122,12 +126,12 @@ pub trait Probe {
     /// [`Readout::model_energy`]), for the step guard, at the coordinates of
     /// the last force evaluation (the state's, or the trigonometric scheme's
     /// filtered ones: see [`Scheme::ENDS_AT_STATE`]) [J].
-    fn model_energy(&mut self, loads: &Loads, state: &State) -> f64;
+    fn model_energy(&mut self, state: &State) -> f64;
     /// Coordinates of the kept or reported modes.
     fn modal_coordinates(&self, state: &State, out: &mut [f64]);
     /// Node positions of `state` (whose forces were evaluated last) into
     /// `out.positions`.
-    fn node_positions(&mut self, loads: &Loads, state: &State, out: &mut Outputs);
+    fn node_positions(&mut self, state: &State, out: &mut Outputs);
     /// Node velocities of `state` into `out.velocities` (held nodes at 0).
     fn node_velocities(&mut self, state: &State, out: &mut Outputs);
     /// Position of one node of `state` (whose forces were evaluated last),
@@ -147,11 +151,12 @@ pub trait Probe {
     /// [`Readout::moments`]; those of the rates are [`Probe::motion`]).
     fn acceleration_moments(&mut self, state: &State) -> Moments;
     /// Elastic energy of every spring at `state` (whose forces were evaluated last) [J].
-    fn elastic_energy(&mut self, loads: &Loads, state: &State) -> f64;
+    fn elastic_energy(&mut self, state: &State) -> f64;
     /// Elastic energy of every spring plus gravity potential at `state` [J].
-    fn potential_energy(&mut self, loads: &Loads, state: &State) -> f64;
-    /// The force the space cannot represent at `state`, relative to the load.
-    fn force_residual(&mut self, loads: &Loads, state: &State) -> f64;
+    fn potential_energy(&mut self, state: &State) -> f64;
+    /// The force the space cannot represent at `state`, relative to the
+    /// load, with gravity and the point load as given (see [`Readout::force_residual`]).
+    fn force_residual(&mut self, gravity: &[f64; 3], point: &[f64; 3], state: &State) -> f64;
 }
 
 /// Everything a simulator reports after a step.
@@ -212,8 +217,8 @@ pub struct Engine<S: Readout, I: Scheme> {
 
 impl<S: Readout, I: Scheme> Engine<S, I> {
     /// Binds `space` to the scheme, or refuses a space the scheme cannot integrate.
-    pub fn new(space: S) -> Result<Self, PhysicsError> {
-        let work = space.work();
+    pub fn new(space: S, loads: &Loads) -> Result<Self, PhysicsError> {
+        let work = space.work(loads);
         I::check(&space, &work)?;
         let n = space.layout().coordinates;
         Ok(Engine { work, buffers: Buffers::new(n, I::SCRATCH), acceleration: vec![0.0; n], current: false, space, scheme: PhantomData })
@@ -225,9 +230,9 @@ impl<S: Readout, I: Scheme> Engine<S, I> {
     }
 
     /// The forces of `work` at `state.y`, evaluated if the last step left them elsewhere.
-    fn current(&mut self, loads: &Loads, state: &State) {
+    fn current(&mut self, state: &State) {
         if !self.current {
-            self.space.force(loads, &state.y, &mut self.work, &mut self.buffers.h);
+            self.space.force(&state.y, &mut self.work, &mut self.buffers.h);
             self.current = true;
         }
     }
@@ -255,51 +260,59 @@ impl<S: Readout, I: Scheme> Stepper for Engine<S, I> {
         self.space.modes()
     }
 
-    fn stable_step(&self, loads: &Loads) -> Option<f64> {
-        I::stable_step(self.space.omega_sq_bound(loads))
+    fn loads(&self) -> &Loads {
+        self.work.as_ref()
     }
 
-    fn omega_sq_bound(&self, loads: &Loads) -> f64 {
-        self.space.omega_sq_bound(loads)
+    fn loads_mut(&mut self) -> &mut Loads {
+        self.work.as_mut()
     }
 
-    fn apply_loads(&mut self, loads: &Loads) {
-        self.space.apply_loads(loads, &mut self.work);
+    fn stable_step(&self) -> Option<f64> {
+        I::stable_step(self.space.omega_sq_bound(&self.work))
+    }
+
+    fn omega_sq_bound(&self) -> f64 {
+        self.space.omega_sq_bound(&self.work)
+    }
+
+    fn apply_loads(&mut self) {
+        self.space.apply_loads(&mut self.work);
     }
 
     fn rest_coordinates(&self, y: &mut [f64]) {
         self.space.rest_coordinates(y);
     }
 
-    fn settle(&mut self, loads: &Loads, state: &mut State) {
-        I::settle(&self.space, &mut self.work, &mut self.buffers, loads, state);
+    fn settle(&mut self, state: &mut State) {
+        I::settle(&self.space, &mut self.work, &mut self.buffers, state);
         self.current = true;
     }
 
-    fn evaluate(&mut self, loads: &Loads, state: &State) {
-        self.space.force(loads, &state.y, &mut self.work, &mut self.buffers.h);
+    fn evaluate(&mut self, state: &State) {
+        self.space.force(&state.y, &mut self.work, &mut self.buffers.h);
         self.current = true;
         // A restored state.a was derived for a step size the buffers do not know.
         self.buffers.filter_step = f64::NAN;
     }
 
-    fn step(&mut self, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure> {
+    fn step(&mut self, state: &mut State, dt: f64) -> Result<(), StepFailure> {
         self.current = I::ENDS_AT_STATE;
-        I::step(&self.space, &mut self.work, &mut self.buffers, loads, state, dt)
+        I::step(&self.space, &mut self.work, &mut self.buffers, state, dt)
     }
 
-    fn kick(&mut self, loads: &Loads, c: &[f64; 3], spin: &[f64; 3], state: &mut State) {
+    fn kick(&mut self, c: &[f64; 3], spin: &[f64; 3], state: &mut State) {
         if *c != [0.0; 3] {
-            self.space.add_translation_rate(loads, c, &mut state.v);
+            self.space.add_translation_rate(&self.work, c, &mut state.v);
         }
         if *spin != [0.0; 3] {
-            self.space.add_rotation_rate(loads, spin, &state.y, &mut state.v);
+            self.space.add_rotation_rate(&self.work, spin, &state.y, &mut state.v);
         }
-        I::settle_rates(&self.space, &mut self.work, &mut self.buffers, loads, state);
+        I::settle_rates(&self.space, &mut self.work, &mut self.buffers, state);
     }
 
-    fn turn(&mut self, loads: &Loads, frame: &Frame) {
-        self.space.turn(loads, frame, &mut self.work);
+    fn turn(&mut self, frame: &Frame) {
+        self.space.turn(frame, &mut self.work);
     }
 
     fn turns(&self) -> bool {
@@ -308,9 +321,9 @@ impl<S: Readout, I: Scheme> Stepper for Engine<S, I> {
 }
 
 impl<S: Readout, I: Scheme> Probe for Engine<S, I> {
-    fn spring_force(&mut self, loads: &Loads, state: &State, y: &[f64], out: &mut [f64]) {
+    fn spring_force(&mut self, state: &State, y: &[f64], out: &mut [f64]) {
         self.space.spring_force(y, &mut self.work, out);
-        self.evaluate(loads, state);
+        self.evaluate(state);
     }
 
     fn momentum(&self, state: &State) -> [f64; 3] {
@@ -325,17 +338,17 @@ impl<S: Readout, I: Scheme> Probe for Engine<S, I> {
         self.space.kinetic_energy(&state.v)
     }
 
-    fn model_energy(&mut self, loads: &Loads, state: &State) -> f64 {
+    fn model_energy(&mut self, state: &State) -> f64 {
         let at = if self.current { &state.y } else { &self.buffers.a1 };
-        self.space.model_energy(loads, at, &mut self.work)
+        self.space.model_energy(at, &mut self.work)
     }
 
     fn modal_coordinates(&self, state: &State, out: &mut [f64]) {
         self.space.modal_coordinates(&state.y, out);
     }
 
-    fn node_positions(&mut self, loads: &Loads, state: &State, out: &mut Outputs) {
-        self.current(loads, state);
+    fn node_positions(&mut self, state: &State, out: &mut Outputs) {
+        self.current(state);
         let scene = self.space.scene();
         let x = self.space.positions(&state.y, &mut self.work);
         match scene.dim {
@@ -381,19 +394,19 @@ impl<S: Readout, I: Scheme> Probe for Engine<S, I> {
         self.space.moments(&state.y, &self.acceleration)
     }
 
-    fn elastic_energy(&mut self, loads: &Loads, state: &State) -> f64 {
-        self.current(loads, state);
+    fn elastic_energy(&mut self, state: &State) -> f64 {
+        self.current(state);
         self.space.elastic_energy(&state.y, &mut self.work)
     }
 
-    fn potential_energy(&mut self, loads: &Loads, state: &State) -> f64 {
-        self.current(loads, state);
-        self.space.elastic_energy(&state.y, &mut self.work) + self.space.gravity_potential(loads, &state.y, &self.work)
+    fn potential_energy(&mut self, state: &State) -> f64 {
+        self.current(state);
+        self.space.elastic_energy(&state.y, &mut self.work) + self.space.gravity_potential(&state.y, &self.work)
     }
 
-    fn force_residual(&mut self, loads: &Loads, state: &State) -> f64 {
-        self.current(loads, state);
-        self.space.force_residual(loads, &state.y, &mut self.work)
+    fn force_residual(&mut self, gravity: &[f64; 3], point: &[f64; 3], state: &State) -> f64 {
+        self.current(state);
+        self.space.force_residual(gravity, point, &state.y, &mut self.work)
     }
 }
 /// Slot-ordered values into node order, for the nodes whose slot is below

@@ -181,6 +181,13 @@ impl Loads {
         Some((self.load_dof(scene)?, self.active_point_load(scene.dim)?))
     }
 
+    /// [`Self::point_force`] with the point load `point` (the load as a
+    /// turned frame sees it) on this load node.
+    pub fn point_force_as<'p>(&self, point: &'p [f64; 3], scene: &Scene) -> Option<(usize, &'p [f64])> {
+        let f = &point[..scene.dim];
+        Some((self.load_dof(scene)?, f.iter().any(|&x| x != 0.0).then_some(f)?))
+    }
+
     /// Refuses loads that do not fit `scene`: a non-zero point load on a
     /// node that is held or not in the scene.
     /// The same loads apart from the anchor's and the holder's targets.

@@ -109,8 +109,8 @@ fn select<const D: usize>(space: &Modal<Exact>, tol: f64, train_poses: &[Vec<f64
     let (scene, modes) = (space.scene(), space.modes());
     let r = modes.basis.r;
     let max_springs = MAX_SPRINGS.min(scene.springs.len() / 2);
-    let mut w = space.work();
-    // F(q) = Phi^T f(x* + Phi q), as the exact model evaluates it.
+    let mut w = space.work(&Loads::physical(r)); // spring forces alone: the loads do not enter
+                                                 // F(q) = Phi^T f(x* + Phi q), as the exact model evaluates it.
     let mut reduced = |q: &[f64], out: &mut [f64]| space.spring_force(q, &mut w, out);
     let mut f0 = vec![0.0; r];
     reduced(&vec![0.0; r], &mut f0);
@@ -259,11 +259,11 @@ fn run_poses(space: &Modal<Exact>, set_up: &Loads, settings: &Settings) -> Resul
             *g -= accel;
         }
     }
-    let mut w = space.work();
-    space.apply_loads(&loads, &mut w);
+    let mut w = space.work(&loads);
+    space.apply_loads(&mut w);
     let mut start = vec![0.0; r];
     space.rest_coordinates(&mut start);
-    let dt = NewmarkExplicit::stable_step(space.omega_sq_bound(&loads)).ok_or(PhysicsError::CubatureTrainingDiverged { time: 0.0 })?;
+    let dt = NewmarkExplicit::stable_step(space.omega_sq_bound(&w)).ok_or(PhysicsError::CubatureTrainingDiverged { time: 0.0 })?;
     let lambda_min = modes.basis.lambda.iter().copied().filter(|l| *l > 0.0).fold(f64::INFINITY, f64::min);
     let span = (2.0 * std::f64::consts::PI / lambda_min.sqrt()).min(RUN_SECONDS);
     let steps = ((span / dt).ceil() as usize).clamp(RUN_POSES, RUN_STEPS);
@@ -271,10 +271,10 @@ fn run_poses(space: &Modal<Exact>, set_up: &Loads, settings: &Settings) -> Resul
     let mut buf = Buffers::new(r, 0);
     let mut state = State::at_rest(r);
     state.y.copy_from_slice(&start);
-    NewmarkExplicit::settle(space, &mut w, &mut buf, &loads, &mut state);
+    NewmarkExplicit::settle(space, &mut w, &mut buf, &mut state);
     let mut run = Vec::with_capacity(RUN_POSES);
     for step in 1..=every * RUN_POSES {
-        let diverged = NewmarkExplicit::step(space, &mut w, &mut buf, &loads, &mut state, dt).is_err();
+        let diverged = NewmarkExplicit::step(space, &mut w, &mut buf, &mut state, dt).is_err();
         if diverged || !state.y.iter().chain(&state.v).all(|z| z.is_finite()) {
             return Err(PhysicsError::CubatureTrainingDiverged { time: step as f64 * dt });
         }

@@ -180,25 +180,25 @@ pub fn snapshots(scene: &Scene, loads: &Loads, settings: &Settings, point: &[f64
             damping_beta: 0.0,
             ..loads.clone()
         };
-        let mut w = space.work();
+        let mut w = space.work(&run_loads);
         let mut buf = Buffers::new(n, NewmarkExplicit::SCRATCH);
         let mut state = State::at_rest(n);
-        space.apply_loads(&run_loads, &mut w);
+        space.apply_loads(&mut w);
         if case.spin != [0.0; 3] {
             // In the holder's frame the sheet at rest gets -Ω x ρ at once.
-            space.turn(&run_loads, &Frame { gravity: case.gravity, load: case.point_load, spin: case.spin }, &mut w);
+            space.turn(&Frame { gravity: case.gravity, load: case.point_load, spin: case.spin }, &mut w);
             let back: [f64; 3] = std::array::from_fn(|i| -case.spin[i]);
-            space.add_rotation_rate(&run_loads, &back, &state.y, &mut state.v);
+            space.add_rotation_rate(&w, &back, &state.y, &mut state.v);
         }
         let diverged = |time: f64| PhysicsError::TrainingDiverged { case: case.label.clone(), time };
-        let stable = NewmarkExplicit::stable_step(space.omega_sq_bound(&run_loads)).ok_or_else(|| diverged(0.0))?;
+        let stable = NewmarkExplicit::stable_step(space.omega_sq_bound(&w)).ok_or_else(|| diverged(0.0))?;
         let time = settings.training.time;
         let steps = ((time / stable).ceil() as usize).max(SAMPLES);
         let dt = time / steps as f64;
-        NewmarkExplicit::settle(&space, &mut w, &mut buf, &run_loads, &mut state);
+        NewmarkExplicit::settle(&space, &mut w, &mut buf, &mut state);
         let mut next = 1;
         for step in 1..=steps {
-            let failed = NewmarkExplicit::step(&space, &mut w, &mut buf, &run_loads, &mut state, dt).is_err();
+            let failed = NewmarkExplicit::step(&space, &mut w, &mut buf, &mut state, dt).is_err();
             if failed || !state.y.iter().chain(&state.v).all(|z| z.is_finite()) {
                 return Err(diverged(step as f64 * dt));
             }

@@ -12,7 +12,7 @@
 use super::scheme::{predict, Buffers, Scheme, EXPLICIT_SAFETY};
 use crate::physics::error::StepFailure;
 use crate::physics::run::space::Space;
-use crate::physics::run::state::{Loads, State};
+use crate::physics::run::state::State;
 
 pub struct NewmarkExplicit;
 
@@ -23,9 +23,9 @@ impl Scheme for NewmarkExplicit {
         (omega > 0.0).then(|| EXPLICIT_SAFETY * 2.0 / omega)
     }
 
-    fn step<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure> {
+    fn step<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, state: &mut State, dt: f64) -> Result<(), StepFailure> {
         predict(&state.y, &state.v, &state.a, dt, &mut buf.y1);
-        space.force(loads, &buf.y1, w, &mut buf.h);
+        space.force(&buf.y1, w, &mut buf.h);
         space.explicit_velocity(dt, &state.v, &state.a, &buf.h, w, &mut buf.v1)?;
         space.acceleration(&buf.v1, &buf.h, w, &mut state.a);
         std::mem::swap(&mut state.v, &mut buf.v1);

@@ -14,7 +14,7 @@
 use super::scheme::{predict, Buffers, Scheme};
 use crate::physics::error::StepFailure;
 use crate::physics::run::space::Space;
-use crate::physics::run::state::{Loads, State};
+use crate::physics::run::state::State;
 
 /// Newton iterations before an implicit step is declared failed.
 pub const MAX_NEWTON_ITERATIONS: usize = 30;
@@ -28,13 +28,13 @@ impl Scheme for NewmarkImplicit {
         None
     }
 
-    fn step<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure> {
+    fn step<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, state: &mut State, dt: f64) -> Result<(), StepFailure> {
         predict(&state.y, &state.v, &state.a, dt, &mut buf.y1);
         let c0 = 4.0 / (dt * dt);
         let c1 = 2.0 / dt;
         let mut done = false;
         for _ in 0..=MAX_NEWTON_ITERATIONS {
-            space.force(loads, &buf.y1, w, &mut buf.h);
+            space.force(&buf.y1, w, &mut buf.h);
             kinematics(state, &buf.y1, dt, &mut buf.v1, &mut buf.a1);
             if done {
                 std::mem::swap(&mut state.y, &mut buf.y1);
@@ -43,7 +43,7 @@ impl Scheme for NewmarkImplicit {
                 return Ok(());
             }
             space.residual(&buf.v1, &buf.a1, &buf.h, w, &mut buf.r);
-            space.factor(loads, c0, c1, w)?;
+            space.factor(c0, c1, w)?;
             space.solve(w, &mut buf.r);
             if !buf.r.iter().all(|d| d.is_finite()) {
                 return Err(StepFailure::SingularNewton { dt });

@@ -4,7 +4,7 @@
 
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::run::space::Space;
-use crate::physics::run::state::{Loads, State};
+use crate::physics::run::state::State;
 
 /// Explicit steps are kept at this fraction of the stability limit 2 / omega.
 pub const EXPLICIT_SAFETY: f64 = 0.9;
@@ -18,7 +18,7 @@ pub trait Scheme: Send + 'static {
 
     /// Advances `state` (not its time) by `dt`. On error `state` may hold
     /// anything; the caller restores its backup.
-    fn step<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure>;
+    fn step<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, state: &mut State, dt: f64) -> Result<(), StepFailure>;
 
     /// Values per coordinate the scheme keeps in [`Buffers::scheme`].
     const SCRATCH: usize = 0;
@@ -33,18 +33,18 @@ pub trait Scheme: Send + 'static {
     }
 
     /// Makes `state.a` what the scheme's next step expects of a state with
-    /// coordinates `state.y` and rates `state.v` under `loads` (at the start,
+    /// coordinates `state.y` and rates `state.v` under the loads of `w` (at the start,
     /// after a change of loads), and leaves the forces of `w` evaluated at
     /// `state.y`. Newmark: the acceleration, M a = h(y) - C v.
-    fn settle<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, loads: &Loads, state: &mut State) {
-        space.force(loads, &state.y, w, &mut buf.h);
+    fn settle<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, state: &mut State) {
+        space.force(&state.y, w, &mut buf.h);
         space.acceleration(&state.v, &buf.h, w, &mut state.a);
     }
 
     /// The same after a change of the rates alone (the anchor's kick,
     /// `docs/method.md`, section 8), with the forces of `w` evaluated at `state.y`.
-    fn settle_rates<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, loads: &Loads, state: &mut State) {
-        Self::settle(space, w, buf, loads, state);
+    fn settle_rates<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, state: &mut State) {
+        Self::settle(space, w, buf, state);
     }
 
     /// The acceleration y'' of the motion the scheme integrates, at

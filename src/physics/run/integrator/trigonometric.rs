@@ -40,7 +40,7 @@
 use super::scheme::{Buffers, Scheme};
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::run::space::{Diagonal, Space};
-use crate::physics::run::state::{Loads, State};
+use crate::physics::run::state::State;
 
 pub struct Trigonometric;
 
@@ -76,10 +76,10 @@ impl Scheme for Trigonometric {
         }
     }
 
-    fn step<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, loads: &Loads, state: &mut State, dt: f64) -> Result<(), StepFailure> {
+    fn step<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, state: &mut State, dt: f64) -> Result<(), StepFailure> {
         if buf.filter_step != dt {
             // e_n at phi y_n for this step size.
-            remainder(space, w, buf, loads, &state.y, dt);
+            remainder(space, w, buf, &state.y, dt);
             state.a.copy_from_slice(&buf.v1);
             buf.filter_step = dt;
         }
@@ -95,7 +95,7 @@ impl Scheme for Trigonometric {
                 buf.a1[i] = p.filter * buf.y1[i];
             }
         }
-        space.force(loads, &buf.a1, w, &mut buf.h);
+        space.force(&buf.a1, w, &mut buf.h);
         let d = diagonal(space, w);
         // The secant stiffness of the filtered rest along the step, |psi (e1 - e0)| / |y1 - y0|.
         let scale = space.layout().newton_scale;
@@ -122,13 +122,13 @@ impl Scheme for Trigonometric {
 
     /// e depends on the step size through the filter, which is not known
     /// yet: the next step evaluates it. The forces are left at `state.y`.
-    fn settle<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, loads: &Loads, state: &mut State) {
-        space.force(loads, &state.y, w, &mut buf.h);
+    fn settle<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, state: &mut State) {
+        space.force(&state.y, w, &mut buf.h);
         buf.filter_step = f64::NAN;
     }
 
     /// e does not depend on the rates; the forces are still at `state.y`.
-    fn settle_rates<S: Space>(_space: &S, _w: &mut S::Work, _buf: &mut Buffers, _loads: &Loads, _state: &mut State) {}
+    fn settle_rates<S: Space>(_space: &S, _w: &mut S::Work, _buf: &mut Buffers, _state: &mut State) {}
 
     /// The motion the scheme integrates: at a fixed point of its step
     /// (y1 = y, v = 0) the exact propagator gives lambda I y = I b + P dt/2 psi_1 e,
@@ -168,14 +168,14 @@ fn diagonal<'a, S: Space>(space: &'a S, w: &'a S::Work) -> Diagonal<'a> {
 }
 
 /// e(phi y) = h(phi y) + lambda phi y - b into `buf.v1` (`buf.a1`: phi y).
-fn remainder<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, loads: &Loads, y: &[f64], dt: f64) {
+fn remainder<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, y: &[f64], dt: f64) {
     {
         let d = diagonal(space, w);
         for ((a, yi), &lambda) in buf.a1.iter_mut().zip(y).zip(d.stiffness) {
             *a = sinc(xi(lambda, dt)) * yi;
         }
     }
-    space.force(loads, &buf.a1, w, &mut buf.h);
+    space.force(&buf.a1, w, &mut buf.h);
     let d = diagonal(space, w);
     for i in 0..y.len() {
         buf.v1[i] = buf.h[i] + d.stiffness[i] * buf.a1[i] - d.load[i];

@@ -62,10 +62,14 @@ struct Fresh {
 }
 
 pub struct Simulator {
+    /// The space and scheme with their work, which holds the loads: the
+    /// one place the physics reads them ([`Simulator::loads`]).
     engine: Box<dyn Stepper>,
     settings: Settings,
     state: State,
-    loads: Loads,
+    /// The loads before the change in progress of [`Simulator::edit_loads`],
+    /// kept to restore them if the change is refused (never read as the loads).
+    spare: Loads,
     /// The state at the start of the current communication step, restored
     /// if it fails (the loads do not change within a step).
     backup: State,
@@ -85,9 +89,16 @@ pub struct Simulator {
     pivot: [f64; 3],
     arm: f64,
     rest_moment: [f64; 3],
-    /// The loads with gravity and the point load turned into the holder's
-    /// frame at the state's time, while it has turned.
-    local: Loads,
+    /// Gravity and the point load turned into the holder's frame at the
+    /// state's orientation, while it has turned.
+    local: FrameLoads,
+}
+
+/// Gravity and the point load in the holder's frame.
+#[derive(Clone, Copy, Debug, Default)]
+struct FrameLoads {
+    gravity: [f64; 3],
+    point_load: [f64; 3],
 }
 
 impl Simulator {
@@ -122,18 +133,17 @@ impl Simulator {
             }
         }
         let mut engine = engine::build(scene, settings, loads, prebuilt)?;
-        engine.apply_loads(loads);
+        engine.apply_loads();
         let mut state = State::at_rest(engine.layout().coordinates);
         engine.rest_coordinates(&mut state.y);
         // The sheet starts at rest wherever the anchor is and however the holder is turned.
         state.anchor[..dim].copy_from_slice(&loads.anchor[..dim]);
         state.rotation = planar(&loads.rotation, dim);
-        let mut local = loads.clone();
-        turn_loads(&mut local, loads, &rotation(&state.rotation), dim);
+        let local = turn_loads(loads, &rotation(&state.rotation), dim);
         if state.rotation != [0.0; 3] {
-            engine.turn(loads, &Frame { gravity: local.gravity, load: local.point_load, spin: [0.0; 3] });
+            engine.turn(&Frame { gravity: local.gravity, load: local.point_load, spin: [0.0; 3] });
         }
-        engine.settle(loads, &mut state);
+        engine.settle(&mut state);
         let mut sim = Simulator {
             outputs: Outputs::new(engine.scene(), settings.n_modes),
             fresh: Fresh::default(),
@@ -142,7 +152,7 @@ impl Simulator {
             state,
             engine,
             settings: settings.clone(),
-            loads: loads.clone(),
+            spare: loads.clone(),
             internal_steps_last: 0,
             free_mass,
             reach,
@@ -171,7 +181,7 @@ impl Simulator {
         }
         Err(PhysicsError::ExplicitTooStiff {
             stable_step: dt,
-            omega_max: self.engine.omega_sq_bound(&self.loads).sqrt(),
+            omega_max: self.engine.omega_sq_bound().sqrt(),
             stiffness_per_mass: self.engine.scene().stiffness_per_mass(),
             per_step,
             max_internal_step: self.settings.max_internal_step,
@@ -185,7 +195,7 @@ impl Simulator {
     /// stiffness a mode sees).
     pub fn max_stable_step(&self) -> f64 {
         let bound = self.settings.max_internal_step;
-        self.engine.stable_step(&self.loads).map_or(bound, |dt| bound.min(dt))
+        self.engine.stable_step().map_or(bound, |dt| bound.min(dt))
     }
 
     /// Advances by `h` seconds in equal internal steps no longer than
@@ -206,7 +216,7 @@ impl Simulator {
         let d = self.scene().dim;
         let (mut rate, mut kick) = ([0.0; 3], [0.0; 3]);
         for i in 0..d {
-            rate[i] = (self.loads.anchor[i] - self.state.anchor[i]) / h;
+            rate[i] = (self.loads().anchor[i] - self.state.anchor[i]) / h;
             kick[i] = self.state.anchor_rate[i] - rate[i];
         }
         let kick_speed = kick.iter().map(|c| c * c).sum::<f64>().sqrt();
@@ -216,7 +226,7 @@ impl Simulator {
         }
         // The holder turns at a constant rate to its target over the step:
         // its spin changes by -turn now, and the free nodes get turn x rho relative to it.
-        let target = planar(&self.loads.rotation, d);
+        let target = planar(&self.loads().rotation, d);
         let spin = frame::spin(&self.state.rotation, &target, h);
         let turn: [f64; 3] = std::array::from_fn(|i| self.state.spin[i] - spin[i]);
         let turning = self.turned() || spin != [0.0; 3];
@@ -231,46 +241,47 @@ impl Simulator {
         self.backup.copy_from(&self.state);
         let start = rotation(&self.state.rotation);
         if turning {
-            self.engine.turn(&self.loads, &self.frame(&start, 0.0, &spin));
+            self.engine.turn(&self.frame(&start, 0.0, &spin));
             kick = apply_transposed(&start, &kick);
         }
         if kick_speed > 0.0 || turn_rate > 0.0 {
-            self.engine.kick(&self.loads, &kick, &turn, &mut self.state);
+            self.engine.kick(&kick, &turn, &mut self.state);
             // The kick's kinetic energy is supplied, not grown.
-            energy_before += self.free_mass * (kick_speed + turn_rate * self.arm).powi(2) * self.loads.weight_max().powi(2);
+            energy_before += self.free_mass * (kick_speed + turn_rate * self.arm).powi(2) * self.loads().weight_max().powi(2);
         }
         let mut result = Ok(());
         for i in 0..steps {
             if spin != [0.0; 3] {
                 // Gravity and the point load turn in the holder's frame: as they are at the step's end.
-                self.engine.turn(&self.loads, &self.frame(&start, (i + 1) as f64 * dt, &spin));
+                self.engine.turn(&self.frame(&start, (i + 1) as f64 * dt, &spin));
             }
-            result = self.engine.step(&self.loads, &mut self.state, dt);
+            result = self.engine.step(&mut self.state, dt);
             if result.is_err() {
                 break;
             }
         }
         // A spinning frame can give the sheet the kinetic energy of its far end at the frame's speed.
-        let spun = self.free_mass * (norm(&spin) * self.arm).powi(2) * self.loads.weight_max().powi(2);
+        let spun = self.free_mass * (norm(&spin) * self.arm).powi(2) * self.loads().weight_max().powi(2);
         if let Err(cause) = result.and_then(|_| self.check_state(dt, energy_before + spun)) {
             self.state.copy_from(&self.backup);
             if turning {
-                self.engine.apply_loads(&self.loads);
+                self.engine.apply_loads();
                 if self.turned() {
-                    self.engine.turn(&self.loads, &self.frame(&start, 0.0, &self.state.spin));
+                    self.engine.turn(&self.frame(&start, 0.0, &self.state.spin));
                 }
             }
-            self.engine.evaluate(&self.loads, &self.state);
+            self.engine.evaluate(&self.state);
             return Err(PhysicsError::StepFailed { time: self.state.time, cause });
         }
         self.internal_steps_last = steps;
         self.state.time += h;
-        self.state.anchor[..d].copy_from_slice(&self.loads.anchor[..d]);
+        let target_anchor = self.loads().anchor;
+        self.state.anchor[..d].copy_from_slice(&target_anchor[..d]);
         self.state.anchor_rate = rate;
         if turning {
             self.state.rotation = target;
             self.state.spin = spin;
-            turn_loads(&mut self.local, &self.loads, &rotation(&target), d);
+            self.local = turn_loads(self.loads(), &rotation(&target), d);
         }
         self.refresh_outputs();
         Ok(())
@@ -278,12 +289,22 @@ impl Simulator {
 
     /// The loads' terms of the space, in the holder's frame once it has turned.
     fn apply_loads(&mut self) {
-        self.engine.apply_loads(&self.loads);
+        self.engine.apply_loads();
         if self.turned() {
             let d = self.scene().dim;
-            turn_loads(&mut self.local, &self.loads, &rotation(&self.state.rotation), d);
+            self.local = turn_loads(self.loads(), &rotation(&self.state.rotation), d);
             let frame = Frame { gravity: self.local.gravity, load: self.local.point_load, spin: self.state.spin };
-            self.engine.turn(&self.loads, &frame);
+            self.engine.turn(&frame);
+        }
+    }
+
+    /// Gravity and the point load as the sheet feels them: in the holder's
+    /// frame once it has turned, else as set.
+    fn felt_loads(&self) -> FrameLoads {
+        if self.turned() {
+            self.local
+        } else {
+            FrameLoads { gravity: self.loads().gravity, point_load: self.loads().point_load }
         }
     }
 
@@ -296,7 +317,7 @@ impl Simulator {
     fn frame(&self, start: &[f64; 9], tau: f64, spin: &[f64; 3]) -> Frame {
         let r = if tau == 0.0 || *spin == [0.0; 3] { *start } else { compose(start, &rotation(&spin.map(|w| w * tau))) };
         let d = self.scene().dim;
-        Frame { gravity: into_frame(&r, &self.loads.gravity, d), load: into_frame(&r, &self.loads.point_load, d), spin: *spin }
+        Frame { gravity: into_frame(&r, &self.loads().gravity, d), load: into_frame(&r, &self.loads().point_load, d), spin: *spin }
     }
 
     /// Rejects non-finite states and kinetic energy that grew far beyond
@@ -306,10 +327,10 @@ impl Simulator {
             return Err(StepFailure::NonFinite { dt });
         }
         let kinetic = self.engine.kinetic_energy(&self.state);
-        let g = self.loads.gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let g = self.loads().gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
         // The point load does at most |f_p| times the reach on its node (`docs/method.md`, section 8).
-        let point = self.loads.active_point_load(self.scene().dim).map_or(0.0, |f| f.iter().map(|c| c * c).sum::<f64>().sqrt());
-        let supply = (self.free_mass * (g + 1.0) + point) * self.reach * self.loads.weight_max();
+        let point = self.loads().active_point_load(self.scene().dim).map_or(0.0, |f| f.iter().map(|c| c * c).sum::<f64>().sqrt());
+        let supply = (self.free_mass * (g + 1.0) + point) * self.reach * self.loads().weight_max();
         if !(kinetic <= ENERGY_GROWTH_LIMIT * (energy_before + supply)) {
             return Err(StepFailure::EnergyGrowth { kinetic, before: energy_before, dt });
         }
@@ -339,7 +360,7 @@ impl Simulator {
             relative + (0..3).map(|i| c[i] * p[i] + 0.5 * self.free_mass * c[i] * c[i]).sum::<f64>()
         };
         self.engine.modal_coordinates(&self.state, &mut self.outputs.modal_coordinates);
-        self.energy = relative + self.engine.model_energy(&self.loads, &self.state).abs();
+        self.energy = relative + self.engine.model_energy(&self.state).abs();
     }
 
     /// The scene being simulated.
@@ -354,8 +375,9 @@ impl Simulator {
     pub fn n_dofs(&self) -> usize {
         self.scene().n_dofs()
     }
+    /// The loads of the run, as the physics reads them.
     pub fn loads(&self) -> &Loads {
-        &self.loads
+        self.engine.loads()
     }
     pub fn settings(&self) -> &Settings {
         &self.settings
@@ -365,26 +387,40 @@ impl Simulator {
         self.internal_steps_last
     }
 
-    /// New loads, effective from now. The acceleration is recomputed at the
-    /// current state, so a load change acts as a step input.
+    /// New loads, effective from now (see [`Self::edit_loads`]).
     pub fn set_loads(&mut self, loads: &Loads) -> Result<(), PhysicsError> {
-        if *loads == self.loads {
+        self.edit_loads(|l| l.clone_from(loads))
+    }
+
+    /// Changes the loads in place, where the physics reads them, effective
+    /// from now: all or nothing (refused loads are restored as they were).
+    /// The acceleration is recomputed at the current state, so a load
+    /// change acts as a step input; a change of the anchor's or the
+    /// holder's targets alone acts from the next step on. Allocates
+    /// nothing when the mode weights keep their number.
+    pub fn edit_loads(&mut self, edit: impl FnOnce(&mut Loads)) -> Result<(), PhysicsError> {
+        self.spare.clone_from(self.engine.loads());
+        edit(self.engine.loads_mut());
+        let loads = self.engine.loads();
+        if *loads == self.spare {
             return Ok(());
         }
-        loads.validate(self.settings.n_modes)?;
-        loads.validate_on(self.scene())?;
-        if !self.engine.turns() && planar(&loads.rotation, self.scene().dim) != self.state.rotation {
-            return Err(PhysicsError::SchemeCannotTurn { scheme: self.settings.integrator });
+        let refused = loads.validate(self.settings.n_modes).and_then(|()| loads.validate_on(self.scene())).and_then(|()| {
+            match !self.engine.turns() && planar(&loads.rotation, self.scene().dim) != self.state.rotation {
+                true => Err(PhysicsError::SchemeCannotTurn { scheme: self.settings.integrator }),
+                false => Ok(()),
+            }
+        });
+        if let Err(e) = refused {
+            std::mem::swap(self.engine.loads_mut(), &mut self.spare);
+            return Err(e);
         }
-        if loads.same_but_anchor(&self.loads) {
+        if loads.same_but_anchor(&self.spare) {
             // The anchor's and the holder's targets act from the next step on; nothing moves now.
-            self.loads.anchor = loads.anchor;
-            self.loads.rotation = loads.rotation;
             return Ok(());
         }
-        self.loads.clone_from(loads);
         self.apply_loads();
-        self.engine.settle(&self.loads, &mut self.state);
+        self.engine.settle(&mut self.state);
         self.refresh_outputs();
         Ok(())
     }
@@ -405,7 +441,7 @@ impl Simulator {
         for (y, d) in self.state.y.iter_mut().zip(dy) {
             *y += d;
         }
-        self.engine.settle(&self.loads, &mut self.state);
+        self.engine.settle(&mut self.state);
         self.refresh_outputs();
         Ok(())
     }
@@ -430,7 +466,7 @@ impl Simulator {
 
     /// The state and the loads: all a run needs to resume.
     pub fn snapshot(&self) -> Snapshot {
-        Snapshot { state: self.state.clone(), loads: self.loads.clone() }
+        Snapshot { state: self.state.clone(), loads: self.loads().clone() }
     }
 
     /// Resumes from a snapshot of a simulator of the same scene and settings.
@@ -450,19 +486,16 @@ impl Simulator {
         if !self.engine.turns() && (s.state.spin != [0.0; 3] || s.state.rotation != planar(&s.loads.rotation, self.scene().dim)) {
             return Err(PhysicsError::SchemeCannotTurn { scheme: self.settings.integrator });
         }
-        self.loads.clone_from(&s.loads);
+        self.engine.loads_mut().clone_from(&s.loads);
         self.state.copy_from(&s.state);
         self.apply_loads();
-        self.engine.evaluate(&self.loads, &self.state);
+        self.engine.evaluate(&self.state);
         self.refresh_outputs();
         Ok(())
     }
 }
 
-/// `local` = `loads` with gravity and the point load turned into the
-/// frame of orientation `r`, reusing `local`'s buffers.
-fn turn_loads(local: &mut Loads, loads: &Loads, r: &[f64; 9], d: usize) {
-    local.clone_from(loads);
-    local.gravity = into_frame(r, &loads.gravity, d);
-    local.point_load = into_frame(r, &loads.point_load, d);
+/// Gravity and the point load of `loads` turned into the frame of orientation `r`.
+fn turn_loads(loads: &Loads, r: &[f64; 9], d: usize) -> FrameLoads {
+    FrameLoads { gravity: into_frame(r, &loads.gravity, d), point_load: into_frame(r, &loads.point_load, d) }
 }

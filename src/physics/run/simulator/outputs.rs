@@ -22,7 +22,7 @@ impl Simulator {
     /// asked after a step.
     pub fn positions(&mut self) -> &[f64] {
         if !self.fresh.positions {
-            self.engine.node_positions(&self.loads, &self.state, &mut self.outputs);
+            self.engine.node_positions(&self.state, &mut self.outputs);
             if self.turned() {
                 self.outputs.frame_positions.copy_from_slice(&self.outputs.positions);
                 let (r, d, a) = (rotation(&self.state.rotation), self.scene().dim, self.state.anchor);
@@ -60,7 +60,7 @@ impl Simulator {
     /// [m]: read from the node positions when they are computed, else
     /// computed for this node alone.
     pub fn load_node_position(&mut self) -> Option<[f64; 3]> {
-        let (node, d) = (self.loads.load_node.filter(|&n| n < self.scene().n_nodes)?, self.scene().dim);
+        let (node, d) = (self.loads().load_node.filter(|&n| n < self.scene().n_nodes)?, self.scene().dim);
         if self.fresh.positions {
             return Some(std::array::from_fn(|i| if i < d { self.outputs.positions[node * d + i] } else { 0.0 }));
         }
@@ -72,7 +72,7 @@ impl Simulator {
     }
     /// Velocity of the load node (z 0 in 2D), if the node is in the scene [m/s].
     pub fn load_node_velocity(&mut self) -> Option<[f64; 3]> {
-        let (node, d) = (self.loads.load_node.filter(|&n| n < self.scene().n_nodes)?, self.scene().dim);
+        let (node, d) = (self.loads().load_node.filter(|&n| n < self.scene().n_nodes)?, self.scene().dim);
         if self.fresh.velocities {
             return Some(std::array::from_fn(|i| if i < d { self.outputs.velocities[node * d + i] } else { 0.0 }));
         }
@@ -95,8 +95,8 @@ impl Simulator {
         if !self.fresh.anchor {
             let driven = self.engine.momentum_rate(&self.state);
             let turned = self.turned();
-            let loads = if turned { &self.local } else { &self.loads };
-            let (d, g, f) = (self.scene().dim, loads.gravity, point_load(loads, self.scene()));
+            let felt = self.felt_loads();
+            let (d, g, f) = (self.scene().dim, felt.gravity, point_load(self.loads(), &felt.point_load, self.scene()));
             let mut force: [f64; 3] = std::array::from_fn(|i| if i < d { self.free_mass * g[i] + f[i] - driven[i] } else { 0.0 });
             if turned {
                 // In the holder's frame, less the Coriolis and centrifugal parts of dP/dt: 2 w x P + w x (w x S).
@@ -118,12 +118,12 @@ impl Simulator {
         if !self.fresh.torque {
             let driven = self.engine.acceleration_moments(&self.state);
             let turned = self.turned();
-            let loads = if turned { &self.local } else { &self.loads };
+            let felt = self.felt_loads();
             let d = self.scene().dim;
-            let g: [f64; 3] = std::array::from_fn(|i| if i < d { loads.gravity[i] } else { 0.0 });
+            let g: [f64; 3] = std::array::from_fn(|i| if i < d { felt.gravity[i] } else { 0.0 });
             let mut t = cross(&driven.first, &g);
-            let f = point_load(loads, self.scene());
-            if let Some(node) = loads.load_node.filter(|_| f != [0.0; 3]) {
+            let f = point_load(self.loads(), &felt.point_load, self.scene());
+            if let Some(node) = self.loads().load_node.filter(|_| f != [0.0; 3]) {
                 let x = self.engine.node_position(&self.state, node);
                 let arm = cross(&std::array::from_fn(|i| x[i] - self.pivot[i]), &f);
                 t = std::array::from_fn(|i| t[i] + arm[i]);
@@ -175,7 +175,7 @@ impl Simulator {
             return Err(PhysicsError::SnapshotLength { len: y.len(), expected: n });
         }
         let mut out = vec![0.0; n];
-        self.engine.spring_force(&self.loads, &self.state, y, &mut out);
+        self.engine.spring_force(&self.state, y, &mut out);
         Ok(out)
     }
     /// The costly products of the set-up (modal space only), to store and
@@ -204,13 +204,13 @@ impl Simulator {
     pub fn potential_energy(&mut self) -> f64 {
         if !self.fresh.potential && self.turned() {
             // Elastic energy, and -g . sum m (X - X_rest) = -g . (m a + R S - S_rest), and -f_p . (X_p - X_p,rest).
-            let (d, point) = (self.scene().dim, point_load(&self.loads, self.scene()));
-            let elastic = self.engine.elastic_energy(&self.loads, &self.state);
+            let (d, point) = (self.scene().dim, point_load(self.loads(), &self.loads().point_load, self.scene()));
+            let elastic = self.engine.elastic_energy(&self.state);
             let s = apply(&rotation(&self.state.rotation), &self.engine.first_moment(&self.state));
-            let g: [f64; 3] = std::array::from_fn(|i| if i < d { self.loads.gravity[i] } else { 0.0 });
+            let g: [f64; 3] = std::array::from_fn(|i| if i < d { self.loads().gravity[i] } else { 0.0 });
             let lowered: [f64; 3] = std::array::from_fn(|i| self.free_mass * self.state.anchor[i] + s[i] - self.rest_moment[i]);
             let mut potential = elastic - dot(&g, &lowered);
-            if let (Some(node), true) = (self.loads.load_node, point != [0.0; 3]) {
+            if let (Some(node), true) = (self.loads().load_node, point != [0.0; 3]) {
                 let x = self.load_node_position().expect("a point load acts on a node of the scene");
                 let slot = self.scene().slot_of_node[node];
                 potential -= (0..d).map(|i| point[i] * (x[i] - self.scene().rest[slot * d + i])).sum::<f64>();
@@ -220,9 +220,9 @@ impl Simulator {
         }
         if !self.fresh.potential {
             // The anchor's displacement a moves every free node: -(m g + f_p) . a more.
-            let (d, point) = (self.scene().dim, point_load(&self.loads, self.scene()));
-            let shifted: f64 = (0..d).map(|i| (self.free_mass * self.loads.gravity[i] + point[i]) * self.state.anchor[i]).sum();
-            self.outputs.potential = self.engine.potential_energy(&self.loads, &self.state) - shifted;
+            let (d, point) = (self.scene().dim, point_load(self.loads(), &self.loads().point_load, self.scene()));
+            let shifted: f64 = (0..d).map(|i| (self.free_mass * self.loads().gravity[i] + point[i]) * self.state.anchor[i]).sum();
+            self.outputs.potential = self.engine.potential_energy(&self.state) - shifted;
             self.fresh.potential = true;
         }
         self.outputs.potential
@@ -231,8 +231,8 @@ impl Simulator {
     /// to the load (0 in full space); computed when first asked after a step.
     pub fn force_residual(&mut self) -> f64 {
         if !self.fresh.residual {
-            let loads = if self.turned() { &self.local } else { &self.loads };
-            self.outputs.force_residual = self.engine.force_residual(loads, &self.state);
+            let felt = self.felt_loads();
+            self.outputs.force_residual = self.engine.force_residual(&felt.gravity, &felt.point_load, &self.state);
             self.fresh.residual = true;
         }
         self.outputs.force_residual
@@ -251,7 +251,7 @@ fn shift(values: &mut [f64], a: &[f64; 3], d: usize) {
     }
 }
 
-/// The point load of `loads` where it acts, on a free load node (z 0 in 2D), else 0 [N].
-fn point_load(loads: &Loads, scene: &Scene) -> [f64; 3] {
-    loads.point_force(scene).map_or([0.0; 3], |(_, f)| std::array::from_fn(|i| f.get(i).copied().unwrap_or(0.0)))
+/// The point load `point` where it acts, on the free load node of `loads` (z 0 in 2D), else 0 [N].
+fn point_load(loads: &Loads, point: &[f64; 3], scene: &Scene) -> [f64; 3] {
+    loads.point_force_as(point, scene).map_or([0.0; 3], |(_, f)| std::array::from_fn(|i| f.get(i).copied().unwrap_or(0.0)))
 }

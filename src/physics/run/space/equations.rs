@@ -46,8 +46,10 @@ pub struct Layout<'a> {
 /// The equations of one space, as the schemes step them; see the module
 /// documentation. What is read from its coordinates is [`Readout`].
 pub trait Space: Send + Sized + 'static {
-    /// Load terms and scratch of one run.
-    type Work: Send + 'static;
+    /// The loads of one run, the terms derived from them and the scratch:
+    /// the one place a run's loads live (read through `as_ref`, changed
+    /// through `as_mut` and then [`Space::apply_loads`]).
+    type Work: Send + 'static + AsRef<Loads> + AsMut<Loads>;
 
     /// The scene the space was built on.
     fn scene(&self) -> &Scene;
@@ -61,17 +63,18 @@ pub trait Space: Send + Sized + 'static {
     fn modes(&self) -> Option<&ModalBasis> {
         None
     }
-    /// Fresh load terms (all zero) and scratch.
-    fn work(&self) -> Self::Work;
+    /// The work of a run under `loads`: the loads, their terms (all zero
+    /// until [`Space::apply_loads`]) and scratch.
+    fn work(&self, loads: &Loads) -> Self::Work;
     /// The coordinates of the scene at rest, where every run starts (0
     /// unless the coordinates are measured from another point than rest).
     fn rest_coordinates(&self, y: &mut [f64]);
 
     /// Derives the load terms (damping per coordinate, generalized gravity
-    /// and point load) from `loads`, once per load change.
-    fn apply_loads(&self, loads: &Loads, w: &mut Self::Work);
+    /// and point load) from the loads of `w`, once per load change.
+    fn apply_loads(&self, w: &mut Self::Work);
     /// h(y) into `h`; leaves the slot positions and the elastic energy at y in `w`.
-    fn force(&self, loads: &Loads, y: &[f64], w: &mut Self::Work, h: &mut [f64]);
+    fn force(&self, y: &[f64], w: &mut Self::Work, h: &mut [f64]);
     /// The velocity update of explicit Newmark: v1 from
     /// (M + dt/2 C) v1 = M (v + dt/2 a) + dt/2 h.
     fn explicit_velocity(&self, dt: f64, v: &[f64], a: &[f64], h: &[f64], w: &mut Self::Work, v1: &mut [f64]) -> Result<(), StepFailure>;
@@ -81,12 +84,12 @@ pub trait Space: Send + Sized + 'static {
     fn residual(&self, v: &[f64], a: &[f64], h: &[f64], w: &mut Self::Work, r: &mut [f64]);
     /// Factors the Newton matrix c_m M + c_c C - dh/dy at the positions of
     /// the last [`Space::force`].
-    fn factor(&self, loads: &Loads, c_m: f64, c_c: f64, w: &mut Self::Work) -> Result<(), StepFailure>;
+    fn factor(&self, c_m: f64, c_c: f64, w: &mut Self::Work) -> Result<(), StepFailure>;
     /// Solves with the last [`Space::factor`], in place.
     fn solve(&self, w: &mut Self::Work, rhs: &mut [f64]);
     /// Upper bound on the squared frequencies of the integrated system
-    /// under `loads`, in any state where no spring is compressed [1/s^2].
-    fn omega_sq_bound(&self, loads: &Loads) -> f64;
+    /// under the loads of `w`, in any state where no spring is compressed [1/s^2].
+    fn omega_sq_bound(&self, w: &Self::Work) -> f64;
     /// The diagonal linear part of the equations under the loads of the
     /// last [`Space::apply_loads`], where there is one (the modal space: the
     /// modes' own springs lambda_i, their Rayleigh damping
@@ -98,19 +101,19 @@ pub trait Space: Send + Sized + 'static {
     /// node with velocity `c` (z is 0 in 2D), each coordinate scaled by its
     /// weight like a load: the velocity kick of an anchor whose velocity
     /// changes by -c (`docs/method.md`, section 8).
-    fn add_translation_rate(&self, loads: &Loads, c: &[f64; 3], v: &mut [f64]);
+    fn add_translation_rate(&self, w: &Self::Work, c: &[f64; 3], v: &mut [f64]);
     /// Adds to the rates `v` at coordinates `y` those of a rigid rotation of
     /// the free nodes about the pivot with angular velocity `c`, c x (x - X0),
     /// weighted like a load: the velocity kick of a holder whose spin
     /// changes by -c (`docs/method.md`, section 8).
-    fn add_rotation_rate(&self, loads: &Loads, c: &[f64; 3], y: &[f64], v: &mut [f64]);
+    fn add_rotation_rate(&self, w: &Self::Work, c: &[f64; 3], y: &[f64], v: &mut [f64]);
     /// The holder has turned (`docs/method.md`, section 8): until the next
     /// [`Space::apply_loads`] the equations are those of its frame: gravity
     /// and the point load as `frame` turns them, the centrifugal force of
     /// its spin with the forces, its Coriolis force with the damping
     /// (in every method above that takes C). Called after
     /// [`Space::apply_loads`], and for every internal step while the holder turns.
-    fn turn(&self, loads: &Loads, frame: &Frame, w: &mut Self::Work);
+    fn turn(&self, frame: &Frame, w: &mut Self::Work);
 }
 
 /// What is read from a space's coordinates: positions, velocities,
@@ -138,14 +141,14 @@ pub trait Readout: Space {
     /// Elastic energy of the springs at y, the coordinates of the last [`Space::force`] [J].
     fn elastic_energy(&self, y: &[f64], w: &mut Self::Work) -> f64;
     /// Potential of gravity and the point load relative to rest at y [J].
-    fn gravity_potential(&self, loads: &Loads, y: &[f64], w: &Self::Work) -> f64;
+    fn gravity_potential(&self, y: &[f64], w: &Self::Work) -> f64;
     /// The potential energy whose gradient the space integrates, at y, the
     /// coordinates of the last [`Space::force`] [J]: elastic energy plus
     /// gravity potential, with the elastic part as the force model sums it
     /// (every spring; the cubature's weighted springs, which costs no more
     /// than one of its steps). The step guard weighs energy growth with it.
-    fn model_energy(&self, loads: &Loads, y: &[f64], w: &mut Self::Work) -> f64 {
-        self.elastic_energy(y, w) + self.gravity_potential(loads, y, w)
+    fn model_energy(&self, y: &[f64], w: &mut Self::Work) -> f64 {
+        self.elastic_energy(y, w) + self.gravity_potential(y, w)
     }
     /// 1/2 v^T M v in physical space [J].
     fn kinetic_energy(&self, v: &[f64]) -> f64;
@@ -162,6 +165,8 @@ pub trait Readout: Space {
     /// Coordinates of the kept or reported modes at y.
     fn modal_coordinates(&self, y: &[f64], out: &mut [f64]);
     /// The part of the physical force at y the space cannot represent,
-    /// relative to the load (`docs/method.md`, section 6); 0 in full space.
-    fn force_residual(&self, loads: &Loads, y: &[f64], w: &mut Self::Work) -> f64;
+    /// relative to the load (`docs/method.md`, section 6), with gravity and
+    /// the point load as `gravity` and `point` give them (in the holder's
+    /// frame once it has turned); 0 in full space.
+    fn force_residual(&self, gravity: &[f64; 3], point: &[f64; 3], y: &[f64], w: &mut Self::Work) -> f64;
 }

@@ -53,6 +53,8 @@ const SKIP: usize = usize::MAX;
 
 /// Load terms and scratch of a full-space run.
 pub struct FullWork {
+    /// The loads of the run: the one place its gravity, point load and damping live.
+    loads: Loads,
     alpha: f64,
     beta: f64,
     /// M g plus the point load, per DOF.
@@ -77,6 +79,18 @@ pub struct FullWork {
     /// The right side and the previous iterate of the Coriolis velocity update.
     rhs: Vec<f64>,
     previous: Vec<f64>,
+}
+
+impl AsRef<Loads> for FullWork {
+    fn as_ref(&self) -> &Loads {
+        &self.loads
+    }
+}
+
+impl AsMut<Loads> for FullWork {
+    fn as_mut(&mut self) -> &mut Loads {
+        &mut self.loads
+    }
 }
 
 impl Full {
@@ -281,7 +295,7 @@ impl Space for Full {
         self.reported.as_ref()
     }
 
-    fn work(&self) -> FullWork {
+    fn work(&self, loads: &Loads) -> FullWork {
         let n = self.scene.n_dofs();
         let req = StackReq::any_of(&[
             self.symbolic.factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default()),
@@ -289,6 +303,7 @@ impl Space for Full {
             self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
         ]);
         FullWork {
+            loads: loads.clone(),
             alpha: 0.0,
             beta: 0.0,
             gravity: vec![0.0; n],
@@ -313,8 +328,9 @@ impl Space for Full {
         u.fill(0.0);
     }
 
-    fn apply_loads(&self, loads: &Loads, w: &mut FullWork) {
+    fn apply_loads(&self, w: &mut FullWork) {
         let d = self.scene.dim;
+        let loads = &w.loads;
         w.alpha = loads.damping_alpha;
         w.beta = loads.damping_beta;
         for (k, g) in w.gravity.iter_mut().enumerate() {
@@ -330,12 +346,12 @@ impl Space for Full {
     }
 
     /// M R^T g + R^T f_p per DOF, and the spin.
-    fn turn(&self, loads: &Loads, frame: &Frame, w: &mut FullWork) {
+    fn turn(&self, frame: &Frame, w: &mut FullWork) {
         let d = self.scene.dim;
         for (k, g) in w.gravity.iter_mut().enumerate() {
             *g = self.scene.dof_mass[k] * frame.gravity[k % d];
         }
-        if let Some((dof, _)) = loads.point_force(&self.scene) {
+        if let Some((dof, _)) = w.loads.point_force(&self.scene) {
             for (i, g) in w.gravity[dof..dof + d].iter_mut().enumerate() {
                 *g += frame.load[i];
             }
@@ -345,7 +361,7 @@ impl Space for Full {
     }
 
     /// u' += c x (x_rest + u - X0) on every free node.
-    fn add_rotation_rate(&self, _loads: &Loads, c: &[f64; 3], u: &[f64], v: &mut [f64]) {
+    fn add_rotation_rate(&self, _w: &FullWork, c: &[f64; 3], u: &[f64], v: &mut [f64]) {
         let d = self.scene.dim;
         for (k, vk) in v.chunks_exact_mut(d).enumerate() {
             let rho: [f64; 3] = std::array::from_fn(|i| if i < d { self.scene.rest[k * d + i] + u[k * d + i] - self.pivot[i] } else { 0.0 });
@@ -358,7 +374,7 @@ impl Space for Full {
 
     /// h(u) = f_springs(x* + u) + M g + f_p; turning, with M R^T g + R^T f_p
     /// and the centrifugal force m (Omega^2 rho - Omega (Omega . rho)), rho = x - X0.
-    fn force(&self, _loads: &Loads, u: &[f64], w: &mut FullWork, h: &mut [f64]) {
+    fn force(&self, u: &[f64], w: &mut FullWork, h: &mut [f64]) {
         for k in 0..u.len() {
             w.x[k] = self.scene.rest[k] + u[k];
         }
@@ -432,7 +448,7 @@ impl Space for Full {
     /// -m (Omega^2 I - Omega Omega^T) joins it; the Coriolis term's skew part
     /// c_c 2 M [Omega]x is left out of the symmetric factor, so Newton then
     /// converges at a rate of about dt |Omega| per iterate instead of quadratically.
-    fn factor(&self, _loads: &Loads, c_m: f64, c_c: f64, w: &mut FullWork) -> Result<(), StepFailure> {
+    fn factor(&self, c_m: f64, c_c: f64, w: &mut FullWork) -> Result<(), StepFailure> {
         w.explicit_factor = None;
         let spin = if w.turning { w.spin } else { [0.0; 3] };
         self.factorize_with_spin(c_m + c_c * w.alpha, c_c * w.beta, &spin, w)
@@ -449,7 +465,7 @@ impl Space for Full {
         }
     }
 
-    fn omega_sq_bound(&self, _loads: &Loads) -> f64 {
+    fn omega_sq_bound(&self, _w: &FullWork) -> f64 {
         self.omega_sq_bound
     }
 
@@ -459,7 +475,7 @@ impl Space for Full {
     }
 
     /// u' += 1 c on every free node.
-    fn add_translation_rate(&self, _loads: &Loads, c: &[f64; 3], v: &mut [f64]) {
+    fn add_translation_rate(&self, _w: &FullWork, c: &[f64; 3], v: &mut [f64]) {
         let d = self.scene.dim;
         for (k, vk) in v.iter_mut().enumerate() {
             *vk += c[k % d];
@@ -485,8 +501,9 @@ impl Readout for Full {
     }
 
     /// -(M g)^T u, summed node by node, and -f_p^T u at the load node.
-    fn gravity_potential(&self, loads: &Loads, u: &[f64], _w: &FullWork) -> f64 {
+    fn gravity_potential(&self, u: &[f64], w: &FullWork) -> f64 {
         let d = self.scene.dim;
+        let loads = &w.loads;
         let g = &loads.gravity;
         let work: f64 = u.chunks_exact(d).zip(self.scene.dof_mass.chunks_exact(d)).map(|(u, m)| (0..d).map(|i| m[i] * g[i] * u[i]).sum::<f64>()).sum();
         match loads.point_force(&self.scene) {
@@ -542,7 +559,7 @@ impl Readout for Full {
     }
 
     /// Every force is represented: 0.
-    fn force_residual(&self, _loads: &Loads, _u: &[f64], _w: &mut FullWork) -> f64 {
+    fn force_residual(&self, _gravity: &[f64; 3], _point: &[f64; 3], _u: &[f64], _w: &mut FullWork) -> f64 {
         0.0
     }
 

@@ -71,8 +71,9 @@ pub struct Modal<F: ReducedForce = Exact> {
 pub struct ModalWork<W> {
     /// c_i = alpha + beta lambda_i.
     damping: Vec<f64>,
-    /// The mode weights w_i of the last [`Space::apply_loads`].
-    weights: Vec<f64>,
+    /// The loads of the run: the one place its mode weights w_i, gravity,
+    /// point load and damping live.
+    loads: Loads,
     /// Phi^T (M g + f_p): gravity and the point load.
     gravity: Vec<f64>,
     /// w_i (Phi^T (M g + f_p))_i: the part of w_i r_i that does not depend on q.
@@ -104,6 +105,18 @@ pub struct ModalWork<W> {
     velocity_perm: Vec<usize>,
     velocity_perm_inv: Vec<usize>,
     velocity_dt: f64,
+}
+
+impl<W> AsRef<Loads> for ModalWork<W> {
+    fn as_ref(&self) -> &Loads {
+        &self.loads
+    }
+}
+
+impl<W> AsMut<Loads> for ModalWork<W> {
+    fn as_mut(&mut self) -> &mut Loads {
+        &mut self.loads
+    }
 }
 
 impl<F: ReducedForce> Modal<F> {
@@ -185,13 +198,13 @@ impl<F: ReducedForce> Space for Modal<F> {
         Some(&self.modes.basis)
     }
 
-    fn work(&self) -> ModalWork<F::Work> {
+    fn work(&self, loads: &Loads) -> ModalWork<F::Work> {
         let r = self.modes.basis.r;
         let req =
             StackReq::any_of(&[lu_in_place_scratch::<usize, f64>(r, r, Par::Seq, Default::default()), solve_in_place_scratch::<usize, f64>(r, 1, Par::Seq)]);
         ModalWork {
             damping: vec![0.0; r],
-            weights: vec![1.0; r],
+            loads: loads.clone(),
             gravity: vec![0.0; r],
             weighted_load: vec![0.0; r],
             gravity_offset: 0.0,
@@ -227,8 +240,9 @@ impl<F: ReducedForce> Space for Modal<F> {
         self.modes.basis.project_displacement(&self.scene.dof_mass, &u, q);
     }
 
-    fn apply_loads(&self, loads: &Loads, w: &mut Self::Work) {
+    fn apply_loads(&self, w: &mut Self::Work) {
         let (n, r, d) = (self.modes.basis.n, self.modes.basis.r, self.scene.dim);
+        let loads = &w.loads;
         for j in 0..r {
             w.damping[j] = loads.damping_alpha + loads.damping_beta * self.modes.basis.lambda[j];
         }
@@ -259,16 +273,15 @@ impl<F: ReducedForce> Space for Modal<F> {
         for ((l, g), wj) in w.weighted_load.iter_mut().zip(&w.gravity).zip(&loads.mode_weights) {
             *l = wj * g;
         }
-        w.weights.copy_from_slice(&loads.mode_weights);
         w.turning = false;
         w.velocity_dt = f64::NAN;
     }
 
     /// Phi^T (M R^T g + R^T f_p) = sum_i T_i (R^T g)_i + Phi_p^T R^T f_p, O(r), and
     /// the spin's terms when it changed, O(r^2) (`docs/method.md`, section 8).
-    fn turn(&self, loads: &Loads, frame: &Frame, w: &mut Self::Work) {
+    fn turn(&self, frame: &Frame, w: &mut Self::Work) {
         let (n, r, d) = (self.modes.basis.n, self.modes.basis.r, self.scene.dim);
-        let point = loads.point_force(&self.scene).map(|(dof, _)| dof);
+        let point = w.loads.point_force(&self.scene).map(|(dof, _)| dof);
         for j in 0..r {
             let t = self.inertia.translation(j);
             w.gravity[j] = t[0] * frame.gravity[0] + t[1] * frame.gravity[1] + t[2] * frame.gravity[2];
@@ -277,7 +290,7 @@ impl<F: ReducedForce> Space for Modal<F> {
                     w.gravity[j] += self.modes.basis.phi[(dof + i) * r + j] * frame.load[i];
                 }
             }
-            w.weighted_load[j] = loads.mode_weights[j] * w.gravity[j];
+            w.weighted_load[j] = w.loads.mode_weights[j] * w.gravity[j];
         }
         w.gravity_offset = -dot(&frame.gravity, &self.sag)
             - point.map_or(0.0, |dof| (0..d).map(|i| frame.load[i] * (self.modes.point[dof + i] - self.scene.rest[dof + i])).sum());
@@ -290,7 +303,7 @@ impl<F: ReducedForce> Space for Modal<F> {
         w.turning = true;
     }
 
-    fn force(&self, loads: &Loads, q: &[f64], w: &mut Self::Work, h: &mut [f64]) {
+    fn force(&self, q: &[f64], w: &mut Self::Work, h: &mut [f64]) {
         // F = Phi^T (f + M g)
         self.force.project(&self.scene, &self.modes, q, &mut w.force, h);
         for (hj, gj) in h.iter_mut().zip(&w.gravity) {
@@ -306,7 +319,7 @@ impl<F: ReducedForce> Space for Modal<F> {
         w.generalized.copy_from_slice(h);
         // weights act on everything but the mode's own linear spring
         for (j, hj) in h.iter_mut().enumerate() {
-            let wj = loads.mode_weights[j];
+            let wj = w.loads.mode_weights[j];
             *hj = wj * *hj + (wj - 1.0) * self.modes.basis.lambda[j] * q[j];
         }
     }
@@ -325,7 +338,7 @@ impl<F: ReducedForce> Space for Modal<F> {
         if w.velocity_dt != dt {
             for j in 0..r {
                 for i in 0..r {
-                    w.velocity[(j, i)] = 0.5 * dt * w.weights[j] * w.coriolis[j * r + i];
+                    w.velocity[(j, i)] = 0.5 * dt * w.loads.mode_weights[j] * w.coriolis[j * r + i];
                 }
                 w.velocity[(j, j)] += 1.0 + 0.5 * dt * w.damping[j];
             }
@@ -348,7 +361,7 @@ impl<F: ReducedForce> Space for Modal<F> {
         for j in 0..r {
             a[j] = h[j] - w.damping[j] * v[j];
             if w.turning {
-                a[j] -= w.weights[j] * dot_slices(&w.coriolis[j * r..(j + 1) * r], v);
+                a[j] -= w.loads.mode_weights[j] * dot_slices(&w.coriolis[j * r..(j + 1) * r], v);
             }
         }
     }
@@ -358,15 +371,15 @@ impl<F: ReducedForce> Space for Modal<F> {
         for j in 0..r {
             res[j] = -(a[j] + w.damping[j] * v[j] - h[j]);
             if w.turning {
-                res[j] -= w.weights[j] * dot_slices(&w.coriolis[j * r..(j + 1) * r], v);
+                res[j] -= w.loads.mode_weights[j] * dot_slices(&w.coriolis[j * r..(j + 1) * r], v);
             }
         }
     }
 
     /// J = c_m I + c_c diag(c) + W Phi^T K(x) Phi - diag((w - 1) lambda), LU with partial pivoting.
-    fn factor(&self, loads: &Loads, c_m: f64, c_c: f64, w: &mut Self::Work) -> Result<(), StepFailure> {
+    fn factor(&self, c_m: f64, c_c: f64, w: &mut Self::Work) -> Result<(), StepFailure> {
         let r = self.modes.basis.r;
-        let weights = &loads.mode_weights;
+        let weights = &w.loads.mode_weights;
         w.kr.fill(0.0);
         self.force.add_tangent(&self.scene, &self.modes, &mut w.force, &mut w.kr);
         for col in 0..r {
@@ -393,8 +406,8 @@ impl<F: ReducedForce> Space for Modal<F> {
     }
 
     /// Weights above 1 scale the stiffness each mode sees beyond its own.
-    fn omega_sq_bound(&self, loads: &Loads) -> f64 {
-        loads.weight_max() * self.omega_sq_bound
+    fn omega_sq_bound(&self, w: &Self::Work) -> f64 {
+        w.loads.weight_max() * self.omega_sq_bound
     }
 
     /// Phi^T K0 Phi = diag(lambda), Phi^T C Phi = diag(alpha + beta lambda),
@@ -404,18 +417,18 @@ impl<F: ReducedForce> Space for Modal<F> {
     }
 
     /// q' += w_j Phi^T M (c x rho): a rigid rotation about the pivot, projected and weighted like every load.
-    fn add_rotation_rate(&self, loads: &Loads, c: &[f64; 3], q: &[f64], v: &mut [f64]) {
+    fn add_rotation_rate(&self, w: &Self::Work, c: &[f64; 3], q: &[f64], v: &mut [f64]) {
         for (j, vj) in v.iter_mut().enumerate() {
-            *vj += loads.mode_weights[j] * self.inertia.rotation_rate(j, c, q);
+            *vj += w.loads.mode_weights[j] * self.inertia.rotation_rate(j, c, q);
         }
     }
 
     /// q' += w_i Phi^T M (1 c): a rigid velocity c of the free nodes,
     /// projected and weighted like every load.
-    fn add_translation_rate(&self, loads: &Loads, c: &[f64; 3], v: &mut [f64]) {
+    fn add_translation_rate(&self, w: &Self::Work, c: &[f64; 3], v: &mut [f64]) {
         for (j, vj) in v.iter_mut().enumerate() {
             let t = self.inertia.translation(j);
-            *vj += loads.mode_weights[j] * (t[0] * c[0] + t[1] * c[1] + t[2] * c[2]);
+            *vj += w.loads.mode_weights[j] * (t[0] * c[0] + t[1] * c[1] + t[2] * c[2]);
         }
     }
 }
@@ -433,12 +446,12 @@ impl<F: ReducedForce> Readout for Modal<F> {
         self.force.elastic_energy(&self.scene, &self.modes, q, &mut w.force)
     }
 
-    fn model_energy(&self, loads: &Loads, q: &[f64], w: &mut Self::Work) -> f64 {
-        self.force.model_energy(&self.scene, &self.modes, q, &mut w.force) + self.gravity_potential(loads, q, w)
+    fn model_energy(&self, q: &[f64], w: &mut Self::Work) -> f64 {
+        self.force.model_energy(&self.scene, &self.modes, q, &mut w.force) + self.gravity_potential(q, w)
     }
 
     /// -(M g + f_p)^T (x - x_rest) = -(M g + f_p)^T (x* - x_rest) - (Phi^T (M g + f_p))^T q.
-    fn gravity_potential(&self, _loads: &Loads, q: &[f64], w: &Self::Work) -> f64 {
+    fn gravity_potential(&self, q: &[f64], w: &Self::Work) -> f64 {
         let modal = -w.gravity.iter().zip(q).map(|(g, q)| g * q).sum::<f64>();
         if self.modes.at_rest {
             modal
@@ -453,21 +466,21 @@ impl<F: ReducedForce> Readout for Modal<F> {
     /// forces' norm where gravity is zero). Since Phi^T M Phi = I, r is
     /// M^-1-orthogonal to M Phi F and ||r||^2 = ||f||^2 - |F|^2: one pass over
     /// the free DOFs, with F kept from the last force evaluation.
-    fn force_residual(&self, loads: &Loads, q: &[f64], w: &mut Self::Work) -> f64 {
+    fn force_residual(&self, gravity: &[f64; 3], point: &[f64; 3], q: &[f64], w: &mut Self::Work) -> f64 {
         let d = self.scene.dim;
         let (mass, inv_mass) = (&self.scene.dof_mass, &self.inv_mass);
         let springs = self.force.spring_forces(&self.scene, &self.modes, q, &mut w.force);
         let (mut total, mut spring) = (0.0, 0.0);
         for (k, fk) in springs.iter().enumerate() {
-            let t = fk + mass[k] * loads.gravity[k % d];
+            let t = fk + mass[k] * gravity[k % d];
             total += t * t * inv_mass[k];
             spring += fk * fk * inv_mass[k];
         }
-        if let Some((dof, f)) = loads.point_force(&self.scene) {
+        if let Some((dof, f)) = w.loads.point_force_as(point, &self.scene) {
             // The point load is part of the physical force on its node.
             for (i, &fi) in f.iter().enumerate() {
                 let k = dof + i;
-                let t = springs[k] + mass[k] * loads.gravity[k % d];
+                let t = springs[k] + mass[k] * gravity[k % d];
                 total += ((t + fi) * (t + fi) - t * t) * inv_mass[k];
             }
         }
