@@ -12,10 +12,10 @@ use common::*;
 use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::fmi::variables::vr;
 use modal_mass_spring::physics::error::StepFailure;
-use modal_mass_spring::physics::run::engine::{Engine, Probe, Stepper};
 use modal_mass_spring::physics::run::frame::{Frame, Moments};
-use modal_mass_spring::physics::run::integrator::{Propagator, Trigonometric};
-use modal_mass_spring::physics::run::space::{Diagonal, Layout, Readout, Space};
+use modal_mass_spring::physics::run::integrator::{Buffers, Propagator, Scheme, Trigonometric};
+use modal_mass_spring::physics::run::simulator::Run;
+use modal_mass_spring::physics::run::space::{Constants, Diagonal, Layout, Readout, Space};
 use modal_mass_spring::physics::*;
 
 // ---------------------------------------------------------------------------
@@ -186,58 +186,76 @@ impl Linear {
     }
 }
 
-impl Space for Linear {
-    type Work = LinearWork;
+impl Constants for Linear {
     fn scene(&self) -> &Scene {
         &self.scene
     }
+
     fn layout(&self) -> Layout<'_> {
         let n = self.lambda.len();
         Layout { scene: &self.scene, coordinates: n, kept_modes: Some(n), springs: 0, frequencies: &self.frequencies, trained: None, newton_scale: 1.0 }
     }
-    fn work(&self, loads: &Loads) -> LinearWork {
-        LinearWork { loads: loads.clone(), damping: vec![0.0; self.lambda.len()], load: vec![0.0; self.lambda.len()] }
-    }
+
     fn rest_coordinates(&self, y: &mut [f64]) {
         y.fill(0.0);
     }
+}
+
+impl Space for Linear {
+    type Work = LinearWork;
+
+    fn work(&self, loads: &Loads) -> LinearWork {
+        LinearWork { loads: loads.clone(), damping: vec![0.0; self.lambda.len()], load: vec![0.0; self.lambda.len()] }
+    }
+
     fn apply_loads(&self, w: &mut LinearWork) {
         for i in 0..self.lambda.len() {
             w.damping[i] = w.loads.damping_alpha + w.loads.damping_beta * self.lambda[i];
             w.load[i] = w.loads.mode_weights[i] * self.load[i];
         }
     }
+
     fn force(&self, y: &[f64], w: &mut LinearWork, h: &mut [f64]) {
         self.evaluations.set(self.evaluations.get() + 1);
         for i in 0..y.len() {
             h[i] = w.load[i] - self.lambda[i] * y[i];
         }
     }
+
     fn explicit_velocity(&self, _dt: f64, _v: &[f64], _a: &[f64], _h: &[f64], _w: &mut LinearWork, _v1: &mut [f64]) -> Result<(), StepFailure> {
         unreachable!("the trigonometric scheme only")
     }
+
     fn acceleration(&self, v: &[f64], h: &[f64], w: &mut LinearWork, a: &mut [f64]) {
         for i in 0..v.len() {
             a[i] = h[i] - w.damping[i] * v[i];
         }
     }
+
     fn residual(&self, _v: &[f64], _a: &[f64], _h: &[f64], _w: &mut LinearWork, _r: &mut [f64]) {
         unreachable!("the trigonometric scheme only")
     }
+
     fn factor(&self, _c_m: f64, _c_c: f64, _w: &mut LinearWork) -> Result<(), StepFailure> {
         unreachable!("the trigonometric scheme only")
     }
+
     fn solve(&self, _w: &mut LinearWork, _rhs: &mut [f64]) {
         unreachable!("the trigonometric scheme only")
     }
+
     fn omega_sq_bound(&self, _w: &LinearWork) -> f64 {
         self.lambda.iter().fold(0.0, |m, &l| m.max(l))
     }
+
     fn diagonal<'a>(&'a self, w: &'a LinearWork) -> Option<Diagonal<'a>> {
         Some(Diagonal { stiffness: &self.lambda, damping: &w.damping, load: &w.load })
     }
+
     fn add_translation_rate(&self, _w: &LinearWork, _c: &[f64; 3], _v: &mut [f64]) {}
+
     fn add_rotation_rate(&self, _w: &LinearWork, _c: &[f64; 3], _y: &[f64], _v: &mut [f64]) {}
+
     fn turn(&self, _frame: &Frame, _w: &mut LinearWork) {}
 }
 
@@ -291,15 +309,17 @@ fn linear_loads(alpha: f64, beta: f64, weights: &[f64]) -> Loads {
 /// `steps` steps of `dt` of the linear space from (y0, v0), after a settle
 /// as at the start of a run; (y, v) after each step.
 fn linear_run(loads: &Loads, y0: &[f64], v0: &[f64], dt: f64, steps: usize) -> Vec<(Vec<f64>, Vec<f64>)> {
-    let mut engine = Engine::<Linear, Trigonometric>::new(Linear::new(&LAMBDA, &LOAD), loads).unwrap();
-    engine.apply_loads();
+    let space = Linear::new(&LAMBDA, &LOAD);
+    let mut w = space.work(loads);
+    space.apply_loads(&mut w);
+    let mut buf = Buffers::new(LAMBDA.len(), Trigonometric::SCRATCH);
     let mut state = State::at_rest(LAMBDA.len());
     state.y.copy_from_slice(y0);
     state.v.copy_from_slice(v0);
-    engine.settle(&mut state);
+    Trigonometric::settle(&space, &mut w, &mut buf, &mut state);
     let mut out = Vec::new();
     for _ in 0..steps {
-        engine.step(&mut state, dt).unwrap();
+        Trigonometric::step(&space, &mut w, &mut buf, &mut state, dt).unwrap();
         out.push((state.y.clone(), state.v.clone()));
     }
     out
@@ -678,20 +698,21 @@ fn refused_in_full_space() {
 #[test]
 fn one_force_evaluation_per_step_until_an_output_needs_the_forces() {
     let loads = linear_loads(0.5, 1e-3, &[1.0; 5]);
-    let mut engine = Engine::<Linear, Trigonometric>::new(Linear::new(&LAMBDA, &LOAD), &loads).unwrap();
-    engine.apply_loads();
-    let mut state = State::at_rest(LAMBDA.len());
-    engine.settle(&mut state);
-    engine.step(&mut state, 0.01).unwrap();
-    let count = |e: &Engine<Linear, Trigonometric>| e.space().evaluations.get();
-    let start = count(&engine);
+    let settings = Settings::new(Reduction::Modal, Integrator::Trigonometric, LAMBDA.len());
+    let mut run = Run::<Linear, Trigonometric>::new(Linear::new(&LAMBDA, &LOAD), &settings, &loads).unwrap();
+    // Away from rest, so that the step guard has an energy to weigh growth against.
+    run.displace(&[0.1; 5]).unwrap();
+    run.do_step(0.01).unwrap();
+    let count = |r: &Run<Linear, Trigonometric>| r.space().evaluations.get();
+    let start = count(&run);
     for _ in 0..10 {
-        engine.step(&mut state, 0.01).unwrap();
-        assert!(engine.model_energy(&state).is_finite());
+        // One internal step per call; the guard weighs the force model's energy each time.
+        run.do_step(0.01).unwrap();
+        assert_eq!(run.internal_steps_last(), 1);
     }
-    assert_eq!(count(&engine) - start, 10, "one evaluation per step, none for the guard");
-    let e1 = engine.potential_energy(&state);
-    assert_eq!(count(&engine) - start, 11, "the potential energy evaluates the forces at the state");
-    let e2 = engine.potential_energy(&state);
-    assert_eq!((count(&engine) - start, e1), (11, e2), "and only once");
+    assert_eq!(count(&run) - start, 10, "one evaluation per step, none for the guard");
+    let e1 = run.potential_energy();
+    assert_eq!(count(&run) - start, 11, "the potential energy evaluates the forces at the state");
+    let e2 = run.potential_energy();
+    assert_eq!((count(&run) - start, e1), (11, e2), "and only once");
 }

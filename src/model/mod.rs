@@ -144,7 +144,7 @@ impl Model for MassSpring {
             // Only tunables and inputs get here; they act from the next step on.
             let sim = self.sim.as_mut().expect("Step Mode has a simulator");
             // Written where the physics reads them, all or nothing.
-            sim.edit_loads(|loads| p.fill_loads(loads)).map_err(|e| messages::describe(&e, p))?;
+            sim.edit_loads(&mut |loads| p.fill_loads(loads)).map_err(|e| messages::describe(&e, p))?;
             // New parameters (gravity turned sideways, weights, damping) are checked after the
             // next step; the inputs a master sets every step (the point load, the holder) are not,
             // or the check would run after every step of a coupled run.

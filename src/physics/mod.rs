@@ -7,7 +7,7 @@
 //!   loads at set-up (scene and grid, modes, equilibrium, bases, the
 //!   trained basis and its program, the cubature's training, mode classes,
 //!   the set-up as data);
-//! - [`run`]: what steps and reads the sheet (spaces, schemes, engine,
+//! - [`run`]: what steps and reads the sheet (spaces, schemes, the
 //!   simulator, forces, the holder's frame, state);
 //!
 //! and beside them [`settings`] (every choice of a set-up, in one type) and
@@ -20,7 +20,7 @@ pub mod setup;
 
 pub use error::{PhysicsError, Quantity, StepFailure};
 pub use run::integrator::EXPLICIT_SAFETY;
-pub use run::simulator::{internal_step_count, Simulator, MAX_INTERNAL_STEPS_PER_CALL, STEP_COUNT_TOLERANCE};
+pub use run::simulator::{internal_step_count, Reads, SetUp, Sheet, Simulator, Steps, MAX_INTERNAL_STEPS_PER_CALL, STEP_COUNT_TOLERANCE};
 pub use run::state::{Loads, Snapshot, State};
 pub use settings::{ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction, Settings, TrainingProgram};
 pub use setup::grid::{FixedNodes, Grid};

@@ -6,15 +6,15 @@
 //!   each a constant model with its own scratch;
 //! - [`integrator`]: the schemes (explicit and implicit Newmark,
 //!   trigonometric), written once against [`space::Space`];
-//! - [`engine`]: a space and a scheme bound together;
 //! - [`frame`]: the holder's frame and the mass moments of the sheet in it;
 //! - [`state`]: [`state::State`] and [`state::Loads`], what changes while running;
-//! - [`simulator`]: set-up, sub-stepping, divergence checks, outputs.
+//! - [`simulator`]: a space and a scheme bound together in a run (generic),
+//!   the registry that chooses them, sub-stepping, divergence checks,
+//!   outputs, behind the narrow traits `Steps`, `Reads` and `SetUp`.
 //!
 //! One modal force evaluation is the pipeline `expand` (q -> x) -> exact
 //! spring forces in physical space -> `project` (Phi^T f).
 
-pub mod engine;
 pub mod forces;
 pub mod frame;
 pub mod integrator;

@@ -20,7 +20,7 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::physics::error::{Expected, PhysicsError, Quantity};
 use crate::physics::run::integrator::{Buffers, NewmarkExplicit, Scheme};
-use crate::physics::run::space::{Candidate, Exact, Modal, Readout, Space};
+use crate::physics::run::space::{Candidate, Constants, Exact, Modal, Readout, Space};
 use crate::physics::run::state::{Loads, State};
 use crate::physics::settings::Settings;
 use crate::physics::setup::scene::Scene;

@@ -1,26 +1,45 @@
 //! The simulator: set-up (the space and scheme the settings name,
 //! bound once), the communication step split into internal steps, the
-//! checks that catch a diverging step, and the outputs (what a host reads,
-//! in `outputs.rs`).
+//! checks that catch a diverging step, and the outputs (what a host reads).
 //!
-//! It holds the constant model (behind [`Stepper`]), the [`State`], the
-//! [`Loads`], a backup of the state taken before every communication step,
-//! and the [`Outputs`] of the last good step. The outputs that cost more
-//! than the reduced state (node positions and velocities, the energy of
-//! every spring, the force residual) are computed when first asked for
-//! after a step and kept until the state changes: a host that reads only
-//! some of them, or reads them less often than it steps, pays only for
-//! those (`docs/method.md`, section 4).
+//! [`Run`] is a space `S` integrated by a scheme `I` with everything that
+//! changes while running: the space's work (which holds the loads), the
+//! [`State`], a backup of the state taken before every communication step,
+//! and the [`Outputs`] of the last good step. It is generic, so a step
+//! calls the space and the scheme without indirection. [`Simulator`] is
+//! the run the settings chose at set-up ([`build`], the registry: which
+//! space, force model and scheme), behind the three narrow traits of
+//! [`Sheet`] that the model and the tests use: [`Steps`] (stepping, the
+//! loads, the state), [`Reads`] (the outputs) and [`SetUp`] (the set-up's
+//! products). The outputs that cost more than the reduced state (node
+//! positions and velocities, the energy of every spring, the force
+//! residual) are computed when first asked for after a step and kept until
+//! the state changes: a host that reads only some of them, or reads them
+//! less often than it steps, pays only for those (`docs/method.md`, section 4).
+//!
+//! - here: the types, the registry and [`Simulator`];
+//! - `sheet.rs`: the traits;
+//! - `stepping.rs`: set-up of a run, the step, load changes, snapshots;
+//! - `outputs.rs`: what a host reads.
 
 mod outputs;
+mod sheet;
+mod stepping;
 
-use crate::physics::error::{positive, Expected, PhysicsError, Quantity, StepFailure};
-use crate::physics::run::engine::{self, Outputs, Stepper};
-use crate::physics::run::frame::{self, apply, apply_transposed, compose, cross, dot, into_frame, norm, planar, rotation, Frame};
-use crate::physics::run::state::{Loads, Snapshot, State};
-use crate::physics::settings::{Reduction, Settings};
+use std::marker::PhantomData;
+use std::ops::{Deref, DerefMut};
+
+pub use sheet::{Reads, SetUp, Sheet, Steps};
+
+use crate::physics::error::{positive, Expected, PhysicsError, Quantity};
+use crate::physics::run::frame::into_frame;
+use crate::physics::run::integrator::{Buffers, NewmarkExplicit, NewmarkImplicit, Scheme, Trigonometric};
+use crate::physics::run::space::{Cubature, Exact, Full, Modal, Readout};
+use crate::physics::run::state::{Loads, State};
+use crate::physics::settings::{ForceEvaluation, Integrator, ModeSelection, Reduction, Settings};
 use crate::physics::setup::scene::Scene;
 use crate::physics::setup::setup_data::SetupData;
+use crate::physics::setup::{cubature_training, trained_basis};
 
 /// Internal steps one communication step may take before it is refused.
 pub const MAX_INTERNAL_STEPS_PER_CALL: usize = 10_000_000;
@@ -61,10 +80,19 @@ struct Fresh {
     residual: bool,
 }
 
-pub struct Simulator {
-    /// The space and scheme with their work, which holds the loads: the
-    /// one place the physics reads them ([`Simulator::loads`]).
-    engine: Box<dyn Stepper>,
+/// Space `S` integrated by scheme `I`, and everything that changes while it runs.
+pub struct Run<S: Readout, I: Scheme> {
+    /// The space: the constant model of the equations.
+    space: S,
+    /// The space's work: the loads (the one place the physics reads them,
+    /// [`Steps::loads`]), their terms and the scratch.
+    work: S::Work,
+    /// The scheme's vectors.
+    buffers: Buffers,
+    /// y'' of the scheme's motion, for the holder's force and torque.
+    acceleration: Vec<f64>,
+    /// The forces of `work` are those at the state's coordinates (see [`Scheme::ENDS_AT_STATE`]).
+    current: bool,
     settings: Settings,
     state: State,
     /// The loads before the change in progress of [`Simulator::edit_loads`],
@@ -92,6 +120,7 @@ pub struct Simulator {
     /// Gravity and the point load turned into the holder's frame at the
     /// state's orientation, while it has turned.
     local: FrameLoads,
+    scheme: PhantomData<I>,
 }
 
 /// Gravity and the point load in the holder's frame.
@@ -100,6 +129,54 @@ struct FrameLoads {
     gravity: [f64; 3],
     point_load: [f64; 3],
 }
+
+/// Everything a simulator reports after a step.
+#[derive(Clone, Debug)]
+pub struct Outputs {
+    /// Node positions in output order, `dim` per node, held nodes included [m].
+    pub positions: Vec<f64>,
+    /// Node velocities, same layout [m/s].
+    pub velocities: Vec<f64>,
+    /// Node positions in the holder's frame, while it has turned [m].
+    pub frame_positions: Vec<f64>,
+    /// Velocities of the free DOFs.
+    pub dof_velocities: Vec<f64>,
+    /// Coordinates of the kept or reported modes.
+    pub modal_coordinates: Vec<f64>,
+    /// 1/2 v^T M v [J].
+    pub kinetic: f64,
+    /// Elastic energy plus gravity potential relative to rest [J].
+    pub potential: f64,
+    /// The part of the force the space cannot represent, relative to the load.
+    pub force_residual: f64,
+    /// The force the sheet exerts on its holder, from the momentum balance
+    /// (`docs/method.md`, section 8) [N]; z is 0 in 2D.
+    pub anchor_force: [f64; 3],
+    /// The torque the sheet exerts on its holder about the pivot [N m].
+    pub anchor_torque: [f64; 3],
+}
+
+impl Outputs {
+    pub fn new(scene: &Scene, modes: usize) -> Self {
+        let nodes = scene.n_nodes * scene.dim;
+        Outputs {
+            positions: vec![0.0; nodes],
+            velocities: vec![0.0; nodes],
+            frame_positions: vec![0.0; nodes],
+            dof_velocities: vec![0.0; scene.n_dofs()],
+            modal_coordinates: vec![0.0; modes],
+            kinetic: 0.0,
+            potential: 0.0,
+            force_residual: 0.0,
+            anchor_force: [0.0; 3],
+            anchor_torque: [0.0; 3],
+        }
+    }
+}
+
+/// The run the settings chose, behind [`Sheet`]: every method of
+/// [`Steps`], [`Reads`] and [`SetUp`] is called on it directly.
+pub struct Simulator(Box<dyn Sheet>);
 
 impl Simulator {
     /// Set-up: builds the space the settings names on `scene` (assembly,
@@ -120,382 +197,90 @@ impl Simulator {
         }
         loads.validate(settings.n_modes)?;
         loads.validate_on(&scene)?;
-        let (free_mass, reach) = (scene.free_mass(), scene.reach());
-        let spacing = scene.springs.iter().map(|s| s.rest).filter(|&l| l > 0.0).fold(f64::INFINITY, f64::min);
-        let dim = scene.dim;
-        let pivot = scene.pivot();
-        let slots = scene.rest.chunks_exact(dim);
-        let arm = slots.clone().map(|x| (0..dim).map(|i| (x[i] - pivot[i]).powi(2)).sum::<f64>().sqrt()).fold(0.0, f64::max) + reach;
-        let mut rest_moment = [0.0; 3];
-        for (k, x) in slots.take(scene.n_free).enumerate() {
-            for i in 0..dim {
-                rest_moment[i] += scene.dof_mass[k * dim] * (x[i] - pivot[i]);
-            }
-        }
-        let mut engine = engine::build(scene, settings, loads, prebuilt)?;
-        engine.apply_loads();
-        let mut state = State::at_rest(engine.layout().coordinates);
-        engine.rest_coordinates(&mut state.y);
-        // The sheet starts at rest wherever the anchor is and however the holder is turned.
-        state.anchor[..dim].copy_from_slice(&loads.anchor[..dim]);
-        state.rotation = planar(&loads.rotation, dim);
-        let local = turn_loads(loads, &rotation(&state.rotation), dim);
-        if state.rotation != [0.0; 3] {
-            engine.turn(&Frame { gravity: local.gravity, load: local.point_load, spin: [0.0; 3] });
-        }
-        engine.settle(&mut state);
-        let mut sim = Simulator {
-            outputs: Outputs::new(engine.scene(), settings.n_modes),
-            fresh: Fresh::default(),
-            energy: 0.0,
-            backup: state.clone(),
-            state,
-            engine,
-            settings: settings.clone(),
-            spare: loads.clone(),
-            internal_steps_last: 0,
-            free_mass,
-            reach,
-            spacing,
-            pivot,
-            arm,
-            rest_moment,
-            local,
-        };
-        sim.check_stable_step_cost()?;
-        sim.refresh_outputs();
-        Ok(sim)
+        Ok(Simulator(build(scene, settings, loads, prebuilt)?))
     }
 
-    /// Refuses a scheme whose stability limit would split every internal
-    /// step bound into more than [`MAX_STABLE_SUBSTEPS`] internal steps,
-    /// saying what sets the limit and what would lift it.
-    fn check_stable_step_cost(&self) -> Result<(), PhysicsError> {
-        if !self.settings.substepping {
-            return Ok(());
-        }
-        let dt = self.max_stable_step();
-        let per_step = self.settings.max_internal_step / dt;
-        if per_step <= MAX_STABLE_SUBSTEPS {
-            return Ok(());
-        }
-        Err(PhysicsError::ExplicitTooStiff {
-            stable_step: dt,
-            omega_max: self.engine.omega_sq_bound().sqrt(),
-            stiffness_per_mass: self.engine.scene().stiffness_per_mass(),
-            per_step,
-            max_internal_step: self.settings.max_internal_step,
-            limit: MAX_STABLE_SUBSTEPS,
-            modes: self.engine.layout().kept_modes,
-        })
-    }
-
-    /// Longest internal step: the internal step bound, and the scheme's
-    /// stability limit under the current loads (weights above 1 scale the
-    /// stiffness a mode sees).
-    pub fn max_stable_step(&self) -> f64 {
-        let bound = self.settings.max_internal_step;
-        self.engine.stable_step().map_or(bound, |dt| bound.min(dt))
-    }
-
-    /// Advances by `h` seconds in equal internal steps no longer than
-    /// [`Self::max_stable_step`]. On error the state is that of the start of the call.
-    pub fn do_step(&mut self, h: f64) -> Result<(), PhysicsError> {
-        positive(Quantity::StepSize, h)?;
-        let dt_max = self.max_stable_step();
-        let steps = if self.settings.substepping { internal_step_count(h, dt_max) } else { 1.0 };
-        if steps > MAX_INTERNAL_STEPS_PER_CALL as f64 {
-            return Err(PhysicsError::TooManyInternalSteps { h, steps, dt: dt_max, limit: MAX_INTERNAL_STEPS_PER_CALL });
-        }
-        let steps = steps as usize;
-        let dt = h / steps as f64;
-        let mut energy_before = self.energy;
-        // The anchor moves linearly to its target over the step: its
-        // velocity changes by `kick` now, and the free nodes, whose absolute
-        // velocity cannot jump, get -kick relative to it (`docs/method.md`, section 8).
-        let d = self.scene().dim;
-        let (mut rate, mut kick) = ([0.0; 3], [0.0; 3]);
-        for i in 0..d {
-            rate[i] = (self.loads().anchor[i] - self.state.anchor[i]) / h;
-            kick[i] = self.state.anchor_rate[i] - rate[i];
-        }
-        let kick_speed = kick.iter().map(|c| c * c).sum::<f64>().sqrt();
-        if !kick_speed.is_finite() || kick_speed * dt > 0.5 * self.spacing {
-            let cause = StepFailure::AnchorTooFast { speed: kick_speed, limit: 0.5 * self.spacing / dt, dt };
-            return Err(PhysicsError::StepFailed { time: self.state.time, cause });
-        }
-        // The holder turns at a constant rate to its target over the step:
-        // its spin changes by -turn now, and the free nodes get turn x rho relative to it.
-        let target = planar(&self.loads().rotation, d);
-        let spin = frame::spin(&self.state.rotation, &target, h);
-        let turn: [f64; 3] = std::array::from_fn(|i| self.state.spin[i] - spin[i]);
-        let turning = self.turned() || spin != [0.0; 3];
-        if (spin != [0.0; 3] || self.state.spin != [0.0; 3]) && !self.engine.turns() {
-            return Err(PhysicsError::SchemeCannotTurn { scheme: self.settings.integrator });
-        }
-        let turn_rate = norm(&turn);
-        if !turn_rate.is_finite() || turn_rate * self.arm * dt > 0.5 * self.spacing {
-            let cause = StepFailure::TurnTooFast { rate: turn_rate, limit: 0.5 * self.spacing / (self.arm * dt), reach: self.arm, dt };
-            return Err(PhysicsError::StepFailed { time: self.state.time, cause });
-        }
-        self.backup.copy_from(&self.state);
-        let start = rotation(&self.state.rotation);
-        if turning {
-            self.engine.turn(&self.frame(&start, 0.0, &spin));
-            kick = apply_transposed(&start, &kick);
-        }
-        if kick_speed > 0.0 || turn_rate > 0.0 {
-            self.engine.kick(&kick, &turn, &mut self.state);
-            // The kick's kinetic energy is supplied, not grown.
-            energy_before += self.free_mass * (kick_speed + turn_rate * self.arm).powi(2) * self.loads().weight_max().powi(2);
-        }
-        let mut result = Ok(());
-        for i in 0..steps {
-            if spin != [0.0; 3] {
-                // Gravity and the point load turn in the holder's frame: as they are at the step's end.
-                self.engine.turn(&self.frame(&start, (i + 1) as f64 * dt, &spin));
-            }
-            result = self.engine.step(&mut self.state, dt);
-            if result.is_err() {
-                break;
-            }
-        }
-        // A spinning frame can give the sheet the kinetic energy of its far end at the frame's speed.
-        let spun = self.free_mass * (norm(&spin) * self.arm).powi(2) * self.loads().weight_max().powi(2);
-        if let Err(cause) = result.and_then(|_| self.check_state(dt, energy_before + spun)) {
-            self.state.copy_from(&self.backup);
-            if turning {
-                self.engine.apply_loads();
-                if self.turned() {
-                    self.engine.turn(&self.frame(&start, 0.0, &self.state.spin));
-                }
-            }
-            self.engine.evaluate(&self.state);
-            return Err(PhysicsError::StepFailed { time: self.state.time, cause });
-        }
-        self.internal_steps_last = steps;
-        self.state.time += h;
-        let target_anchor = self.loads().anchor;
-        self.state.anchor[..d].copy_from_slice(&target_anchor[..d]);
-        self.state.anchor_rate = rate;
-        if turning {
-            self.state.rotation = target;
-            self.state.spin = spin;
-            self.local = turn_loads(self.loads(), &rotation(&target), d);
-        }
-        self.refresh_outputs();
-        Ok(())
-    }
-
-    /// The loads' terms of the space, in the holder's frame once it has turned.
-    fn apply_loads(&mut self) {
-        self.engine.apply_loads();
-        if self.turned() {
-            let d = self.scene().dim;
-            self.local = turn_loads(self.loads(), &rotation(&self.state.rotation), d);
-            let frame = Frame { gravity: self.local.gravity, load: self.local.point_load, spin: self.state.spin };
-            self.engine.turn(&frame);
-        }
-    }
-
-    /// Gravity and the point load as the sheet feels them: in the holder's
-    /// frame once it has turned, else as set.
-    fn felt_loads(&self) -> FrameLoads {
-        if self.turned() {
-            self.local
-        } else {
-            FrameLoads { gravity: self.loads().gravity, point_load: self.loads().point_load }
-        }
-    }
-
-    /// The holder has left its rest orientation or turns.
-    fn turned(&self) -> bool {
-        self.state.rotation != [0.0; 3] || self.state.spin != [0.0; 3]
-    }
-
-    /// The holder's frame `tau` after the orientation `start`, turning at `spin`.
-    fn frame(&self, start: &[f64; 9], tau: f64, spin: &[f64; 3]) -> Frame {
-        let r = if tau == 0.0 || *spin == [0.0; 3] { *start } else { compose(start, &rotation(&spin.map(|w| w * tau))) };
-        let d = self.scene().dim;
-        Frame { gravity: into_frame(&r, &self.loads().gravity, d), load: into_frame(&r, &self.loads().point_load, d), spin: *spin }
-    }
-
-    /// Rejects non-finite states and kinetic energy that grew far beyond
-    /// what the loads could supply.
-    fn check_state(&self, dt: f64, energy_before: f64) -> Result<(), StepFailure> {
-        if !self.state.y.iter().chain(&self.state.v).all(|z| z.is_finite()) {
-            return Err(StepFailure::NonFinite { dt });
-        }
-        let kinetic = self.engine.kinetic_energy(&self.state);
-        let g = self.loads().gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
-        // The point load does at most |f_p| times the reach on its node (`docs/method.md`, section 8).
-        let point = self.loads().active_point_load(self.scene().dim).map_or(0.0, |f| f.iter().map(|c| c * c).sum::<f64>().sqrt());
-        let supply = (self.free_mass * (g + 1.0) + point) * self.reach * self.loads().weight_max();
-        if !(kinetic <= ENERGY_GROWTH_LIMIT * (energy_before + supply)) {
-            return Err(StepFailure::EnergyGrowth { kinetic, before: energy_before, dt });
-        }
-        Ok(())
-    }
-
-    /// After every change of the state or the loads: the cheap outputs and
-    /// the guard's energy now, the costly ones when asked for.
-    fn refresh_outputs(&mut self) {
-        self.fresh = Fresh::default();
-        let relative = self.engine.kinetic_energy(&self.state);
-        // In the ground's frame: 1/2 (v + c)^T M (v + c), c the anchor's velocity.
-        let c = self.state.anchor_rate;
-        self.outputs.kinetic = if self.turned() {
-            // 1/2 sum m |c + R (v + w x rho)|^2 = 1/2 sum m |v|^2 + w . L + 1/2 (|w|^2 tr J - w^T J w)
-            //   + c . R (P + w x S) + 1/2 m |c|^2, with the moments of the rates.
-            let (r, w, m) = (rotation(&self.state.rotation), self.state.spin, self.engine.motion(&self.state));
-            let j = &m.second;
-            let inner = relative + dot(&w, &m.angular()) + 0.5 * (dot(&w, &w) * (j[0] + j[4] + j[8]) - dot(&w, &apply(j, &w)));
-            let sw = cross(&w, &m.first);
-            let frame = apply(&r, &std::array::from_fn(|i| m.momentum[i] + sw[i]));
-            inner + dot(&c, &frame) + 0.5 * self.free_mass * dot(&c, &c)
-        } else if c == [0.0; 3] {
-            relative
-        } else {
-            let p = self.engine.momentum(&self.state);
-            relative + (0..3).map(|i| c[i] * p[i] + 0.5 * self.free_mass * c[i] * c[i]).sum::<f64>()
-        };
-        self.engine.modal_coordinates(&self.state, &mut self.outputs.modal_coordinates);
-        self.energy = relative + self.engine.model_energy(&self.state).abs();
-    }
-
-    /// The scene being simulated.
-    pub fn scene(&self) -> &Scene {
-        self.engine.scene()
-    }
-    /// Time since the start of the run [s].
-    pub fn time(&self) -> f64 {
-        self.state.time
-    }
-    /// Free degrees of freedom.
-    pub fn n_dofs(&self) -> usize {
-        self.scene().n_dofs()
-    }
-    /// The loads of the run, as the physics reads them.
-    pub fn loads(&self) -> &Loads {
-        self.engine.loads()
-    }
-    pub fn settings(&self) -> &Settings {
-        &self.settings
-    }
-    /// Internal steps taken by the last successful `do_step`.
-    pub fn internal_steps_last(&self) -> usize {
-        self.internal_steps_last
-    }
-
-    /// New loads, effective from now (see [`Self::edit_loads`]).
+    /// New loads, effective from now (see [`Steps::edit_loads`]).
     pub fn set_loads(&mut self, loads: &Loads) -> Result<(), PhysicsError> {
-        self.edit_loads(|l| l.clone_from(loads))
+        self.0.edit_loads(&mut |l| l.clone_from(loads))
     }
+}
 
-    /// Changes the loads in place, where the physics reads them, effective
-    /// from now: all or nothing (refused loads are restored as they were).
-    /// The acceleration is recomputed at the current state, so a load
-    /// change acts as a step input; a change of the anchor's or the
-    /// holder's targets alone acts from the next step on. Allocates
-    /// nothing when the mode weights keep their number.
-    pub fn edit_loads(&mut self, edit: impl FnOnce(&mut Loads)) -> Result<(), PhysicsError> {
-        self.spare.clone_from(self.engine.loads());
-        edit(self.engine.loads_mut());
-        let loads = self.engine.loads();
-        if *loads == self.spare {
-            return Ok(());
+impl Deref for Simulator {
+    type Target = dyn Sheet;
+    fn deref(&self) -> &(dyn Sheet + 'static) {
+        &*self.0
+    }
+}
+
+impl DerefMut for Simulator {
+    fn deref_mut(&mut self) -> &mut (dyn Sheet + 'static) {
+        &mut *self.0
+    }
+}
+
+/// The registry: builds the space `settings.reduction` names on `scene`
+/// (with the force model `settings.force_evaluation` names in the modal
+/// space) and binds it to the scheme `settings.integrator` names, or
+/// refuses a pair the scheme cannot integrate. `loads` are those at
+/// set-up: the basis options that depend on the loads use them.
+/// `prebuilt` (modal space only) replaces the costly part of the set-up.
+fn build(scene: Scene, settings: &Settings, loads: &Loads, prebuilt: Option<&SetupData>) -> Result<Box<dyn Sheet>, PhysicsError> {
+    // A trained basis (and its cubature) comes from its training program unless it is stored.
+    let trained_basis;
+    let prebuilt = match prebuilt {
+        None if settings.reduction == Reduction::Modal && settings.mode_selection == ModeSelection::Trained => {
+            trained_basis = trained_basis::train(scene.clone(), loads, settings)?;
+            Some(&trained_basis)
         }
-        let refused = loads.validate(self.settings.n_modes).and_then(|()| loads.validate_on(self.scene())).and_then(|()| {
-            match !self.engine.turns() && planar(&loads.rotation, self.scene().dim) != self.state.rotation {
-                true => Err(PhysicsError::SchemeCannotTurn { scheme: self.settings.integrator }),
-                false => Ok(()),
+        given => given,
+    };
+    match settings.reduction {
+        Reduction::Modal => match settings.force_evaluation {
+            ForceEvaluation::Exact => bind(Modal::<Exact>::new(scene, loads, settings, prebuilt)?, settings, loads),
+            ForceEvaluation::Cubature => {
+                // The spring set is trained on the exact reduced model unless it is stored.
+                let trained;
+                let prebuilt = match prebuilt {
+                    Some(data) if data.cubature.is_some() => Some(data),
+                    _ => {
+                        trained = cubature_training::train(scene.clone(), loads, settings, prebuilt, None)?;
+                        Some(&trained)
+                    }
+                };
+                bind(Modal::<Cubature>::new(scene, loads, settings, prebuilt)?, settings, loads)
             }
-        });
-        if let Err(e) = refused {
-            std::mem::swap(self.engine.loads_mut(), &mut self.spare);
-            return Err(e);
-        }
-        if loads.same_but_anchor(&self.spare) {
-            // The anchor's and the holder's targets act from the next step on; nothing moves now.
-            return Ok(());
-        }
-        self.apply_loads();
-        self.engine.settle(&mut self.state);
-        self.refresh_outputs();
-        Ok(())
+        },
+        Reduction::Full => bind(Full::new(scene, loads, settings)?, settings, loads),
     }
+}
 
-    /// Moves the generalized coordinates by `dy` (displacements of the free
-    /// DOFs in full space, modal coordinates in the modal space) and makes
-    /// the accelerations those of the new positions, as at the start of a
-    /// run: the start of a twin run a hair away from this one, which shows
-    /// how far a scene is predictable (`docs/method.md`, section 6). On
-    /// error nothing changes.
-    pub fn displace(&mut self, dy: &[f64]) -> Result<(), PhysicsError> {
-        if dy.len() != self.state.len() {
-            return Err(PhysicsError::SnapshotLength { len: dy.len(), expected: self.state.len() });
-        }
-        if !dy.iter().all(|x| x.is_finite()) {
-            return Err(PhysicsError::SnapshotNotFinite);
-        }
-        for (y, d) in self.state.y.iter_mut().zip(dy) {
-            *y += d;
-        }
-        self.engine.settle(&mut self.state);
-        self.refresh_outputs();
-        Ok(())
-    }
-
-    /// [`Self::displace`] by a displacement `dy` of the free DOFs: in the
-    /// modal space by its modal coordinates q = Phi^T M dy (the part the
-    /// basis holds).
-    pub fn displace_dofs(&mut self, dy: &[f64]) -> Result<(), PhysicsError> {
-        if dy.len() != self.n_dofs() {
-            return Err(PhysicsError::SnapshotLength { len: dy.len(), expected: self.n_dofs() });
-        }
-        let q = match (self.engine.layout().kept_modes, self.engine.modes()) {
-            (Some(r), Some(basis)) => {
-                let mut q = vec![0.0; r];
-                basis.project_displacement(&self.engine.scene().dof_mass, dy, &mut q);
-                q
-            }
-            _ => dy.to_vec(),
-        };
-        self.displace(&q)
-    }
-
-    /// The state and the loads: all a run needs to resume.
-    pub fn snapshot(&self) -> Snapshot {
-        Snapshot { state: self.state.clone(), loads: self.loads().clone() }
-    }
-
-    /// Resumes from a snapshot of a simulator of the same scene and settings.
-    /// On error nothing changes.
-    pub fn restore(&mut self, s: &Snapshot) -> Result<(), PhysicsError> {
-        let n = self.state.len();
-        for len in [s.state.y.len(), s.state.v.len(), s.state.a.len()] {
-            if len != n {
-                return Err(PhysicsError::SnapshotLength { len, expected: n });
-            }
-        }
-        if !s.state.is_finite() {
-            return Err(PhysicsError::SnapshotNotFinite);
-        }
-        s.loads.validate(self.settings.n_modes)?;
-        s.loads.validate_on(self.scene())?;
-        if !self.engine.turns() && (s.state.spin != [0.0; 3] || s.state.rotation != planar(&s.loads.rotation, self.scene().dim)) {
-            return Err(PhysicsError::SchemeCannotTurn { scheme: self.settings.integrator });
-        }
-        self.engine.loads_mut().clone_from(&s.loads);
-        self.state.copy_from(&s.state);
-        self.apply_loads();
-        self.engine.evaluate(&self.state);
-        self.refresh_outputs();
-        Ok(())
-    }
+/// Binds `space` to the scheme `settings.integrator` names.
+fn bind<S: Readout>(space: S, settings: &Settings, loads: &Loads) -> Result<Box<dyn Sheet>, PhysicsError> {
+    Ok(match settings.integrator {
+        Integrator::NewmarkExplicit => Box::new(Run::<S, NewmarkExplicit>::new(space, settings, loads)?),
+        Integrator::NewmarkImplicit => Box::new(Run::<S, NewmarkImplicit>::new(space, settings, loads)?),
+        Integrator::Trigonometric => Box::new(Run::<S, Trigonometric>::new(space, settings, loads)?),
+    })
 }
 
 /// Gravity and the point load of `loads` turned into the frame of orientation `r`.
 fn turn_loads(loads: &Loads, r: &[f64; 9], d: usize) -> FrameLoads {
     FrameLoads { gravity: into_frame(r, &loads.gravity, d), point_load: into_frame(r, &loads.point_load, d) }
+}
+
+/// Slot-ordered values into node order, for the nodes whose slot is below
+/// `limit` (the free slots for velocities; every slot for positions); the
+/// other nodes get 0 (held nodes have no velocity of their own: the
+/// anchor's is added to every node afterwards). Fixed length `D` keeps each
+/// copy a pair of moves instead of a `memmove` call.
+fn to_node_order<const D: usize>(slot_of_node: &[usize], limit: usize, from: &[f64], to: &mut [f64]) {
+    for (&slot, t) in slot_of_node.iter().zip(to.chunks_exact_mut(D)) {
+        let t = <&mut [f64; D]>::try_from(t).expect("D values");
+        if slot < limit {
+            *t = *<&[f64; D]>::try_from(&from[slot * D..slot * D + D]).expect("D values");
+        } else {
+            *t = [0.0; D];
+        }
+    }
 }

@@ -1,28 +1,85 @@
-//! What a host reads of the simulator: node positions and velocities and
-//! those of the load node, in the ground's frame (the sheet is integrated
-//! in its holder's, `docs/method.md`, section 8); the force and torque the
-//! sheet exerts on its holder; the energies and the force residual; the
-//! kept modes and their classes; and the diagnostics of the set-up (spring
-//! force at given coordinates, its costly products, the trained range, the
-//! cubature). The costly ones are computed when first asked for after a
-//! step and kept until the state changes (the [`Simulator`]'s `fresh`).
+//! What a host reads of a run: node positions and velocities and those of
+//! the load node, in the ground's frame (the sheet is integrated in its
+//! holder's, `docs/method.md`, section 8); the force and torque the sheet
+//! exerts on its holder; the energies and the force residual ([`Reads`]);
+//! and the products of the set-up: the kept modes and their classes, its
+//! costly data, the cubature ([`SetUp`]). The costly ones are computed
+//! when first asked for after a step and kept until the state changes
+//! (the run's `fresh`).
 
-use super::Simulator;
+use super::{to_node_order, Reads, Run, SetUp, Steps};
 use crate::physics::error::PhysicsError;
 use crate::physics::run::frame::{apply, cross, dot, ground_velocity, place, rotation};
+use crate::physics::run::integrator::Scheme;
+use crate::physics::run::space::Readout;
 use crate::physics::run::state::Loads;
 use crate::physics::setup::mode_classes::{self, ModeClasses};
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
 use crate::physics::setup::setup_data::SetupData;
 
-impl Simulator {
-    /// Node positions, `dim` per node in the scene's output order, held
-    /// nodes included [m]. The modal space expands them from q when first
-    /// asked after a step.
-    pub fn positions(&mut self) -> &[f64] {
+impl<S: Readout, I: Scheme> Run<S, I> {
+    /// Node positions of the state (forces evaluated there) into `outputs.positions`, in the holder's frame.
+    fn node_positions_now(&mut self) {
+        self.forces_current();
+        let scene = self.space.scene();
+        let x = self.space.positions(&self.state.y, &mut self.work);
+        match scene.dim {
+            2 => to_node_order::<2>(&scene.slot_of_node, usize::MAX, x, &mut self.outputs.positions),
+            _ => to_node_order::<3>(&scene.slot_of_node, usize::MAX, x, &mut self.outputs.positions),
+        }
+    }
+
+    /// Node velocities of the state into `outputs.velocities` (held nodes at 0), relative to the holder.
+    fn node_velocities_now(&mut self) {
+        let scene = self.space.scene();
+        self.space.dof_velocities(&self.state.v, &mut self.outputs.dof_velocities);
+        match scene.dim {
+            2 => to_node_order::<2>(&scene.slot_of_node, scene.n_free, &self.outputs.dof_velocities, &mut self.outputs.velocities),
+            _ => to_node_order::<3>(&scene.slot_of_node, scene.n_free, &self.outputs.dof_velocities, &mut self.outputs.velocities),
+        }
+    }
+
+    /// Position of one node of the state (whose forces were evaluated last), without the others; z is 0 in 2D.
+    fn node_position_now(&mut self, node: usize) -> [f64; 3] {
+        self.space.slot_position(&self.state.y, self.space.scene().slot_of_node[node], &mut self.work)
+    }
+
+    /// Velocity of one node of the state (0 for a held node); z is 0 in 2D.
+    fn node_velocity_now(&self, node: usize) -> [f64; 3] {
+        let scene = self.space.scene();
+        let slot = scene.slot_of_node[node];
+        if slot < scene.n_free {
+            self.space.slot_velocity(&self.state.v, slot)
+        } else {
+            [0.0; 3]
+        }
+    }
+
+    /// Elastic energy of every spring at the state [J].
+    fn elastic_energy_now(&mut self) -> f64 {
+        self.forces_current();
+        self.space.elastic_energy(&self.state.y, &mut self.work)
+    }
+
+    /// Elastic energy of every spring plus gravity potential at the state [J].
+    fn potential_energy_now(&mut self) -> f64 {
+        self.forces_current();
+        self.space.elastic_energy(&self.state.y, &mut self.work) + self.space.gravity_potential(&self.state.y, &self.work)
+    }
+
+    /// The force the space cannot represent at the state, relative to the
+    /// load, with gravity and the point load as given (see [`Readout::force_residual`]).
+    fn force_residual_now(&mut self, gravity: &[f64; 3], point: &[f64; 3]) -> f64 {
+        self.forces_current();
+        self.space.force_residual(gravity, point, &self.state.y, &mut self.work)
+    }
+}
+
+impl<S: Readout, I: Scheme> Reads for Run<S, I> {
+    fn positions(&mut self) -> &[f64] {
         if !self.fresh.positions {
-            self.engine.node_positions(&self.state, &mut self.outputs);
+            self.node_positions_now();
             if self.turned() {
                 self.outputs.frame_positions.copy_from_slice(&self.outputs.positions);
                 let (r, d, a) = (rotation(&self.state.rotation), self.scene().dim, self.state.anchor);
@@ -31,16 +88,16 @@ impl Simulator {
                     x.copy_from_slice(&p[..d]);
                 }
             } else {
-                shift(&mut self.outputs.positions, &self.state.anchor, self.engine.scene().dim);
+                shift(&mut self.outputs.positions, &self.state.anchor, self.space.scene().dim);
             }
             self.fresh.positions = true;
         }
         &self.outputs.positions
     }
-    /// Node velocities, same layout as positions [m/s].
-    pub fn velocities(&mut self) -> &[f64] {
+
+    fn velocities(&mut self) -> &[f64] {
         if !self.fresh.velocities {
-            self.engine.node_velocities(&self.state, &mut self.outputs);
+            self.node_velocities_now();
             if self.turned() {
                 self.positions();
                 let (r, d) = (rotation(&self.state.rotation), self.scene().dim);
@@ -50,57 +107,49 @@ impl Simulator {
                     v.copy_from_slice(&u[..d]);
                 }
             } else {
-                shift(&mut self.outputs.velocities, &self.state.anchor_rate, self.engine.scene().dim);
+                shift(&mut self.outputs.velocities, &self.state.anchor_rate, self.space.scene().dim);
             }
             self.fresh.velocities = true;
         }
         &self.outputs.velocities
     }
-    /// Position of the load node (z 0 in 2D), if the node is in the scene
-    /// [m]: read from the node positions when they are computed, else
-    /// computed for this node alone.
-    pub fn load_node_position(&mut self) -> Option<[f64; 3]> {
+
+    fn load_node_position(&mut self) -> Option<[f64; 3]> {
         let (node, d) = (self.loads().load_node.filter(|&n| n < self.scene().n_nodes)?, self.scene().dim);
         if self.fresh.positions {
             return Some(std::array::from_fn(|i| if i < d { self.outputs.positions[node * d + i] } else { 0.0 }));
         }
-        let x = self.engine.node_position(&self.state, node);
+        let x = self.node_position_now(node);
         if self.turned() {
             return Some(place(&self.pivot, &self.state.anchor, &rotation(&self.state.rotation), &x[..d]));
         }
         Some(std::array::from_fn(|i| if i < d { x[i] + self.state.anchor[i] } else { 0.0 }))
     }
-    /// Velocity of the load node (z 0 in 2D), if the node is in the scene [m/s].
-    pub fn load_node_velocity(&mut self) -> Option<[f64; 3]> {
+
+    fn load_node_velocity(&mut self) -> Option<[f64; 3]> {
         let (node, d) = (self.loads().load_node.filter(|&n| n < self.scene().n_nodes)?, self.scene().dim);
         if self.fresh.velocities {
             return Some(std::array::from_fn(|i| if i < d { self.outputs.velocities[node * d + i] } else { 0.0 }));
         }
-        let v = self.engine.node_velocity(&self.state, node);
+        let v = self.node_velocity_now(node);
         if self.turned() {
-            let x = self.engine.node_position(&self.state, node);
+            let x = self.node_position_now(node);
             let (c, w) = (self.state.anchor_rate, self.state.spin);
             return Some(ground_velocity(&self.pivot, &c, &w, &rotation(&self.state.rotation), &v[..d], &x[..d]));
         }
         Some(std::array::from_fn(|i| if i < d { v[i] + self.state.anchor_rate[i] } else { 0.0 }))
     }
-    /// The force the sheet exerts on its holder, from the momentum balance
-    /// of the free nodes (`docs/method.md`, section 8):
-    /// F = m_free g + f_p - sum M y'', y'' of the motion the scheme
-    /// integrates, so the damping's reaction (it acts on the motion
-    /// relative to the holder) is the holder's and, in 3D, so is what the
-    /// auxiliary springs carry (their points ride with the holder). O(r) in
-    /// the modal space; z is 0 in 2D [N].
-    pub fn anchor_force(&mut self) -> [f64; 3] {
+
+    fn anchor_force(&mut self) -> [f64; 3] {
         if !self.fresh.anchor {
-            let driven = self.engine.momentum_rate(&self.state);
+            let driven = self.momentum_rate_now();
             let turned = self.turned();
             let felt = self.felt_loads();
             let (d, g, f) = (self.scene().dim, felt.gravity, point_load(self.loads(), &felt.point_load, self.scene()));
             let mut force: [f64; 3] = std::array::from_fn(|i| if i < d { self.free_mass * g[i] + f[i] - driven[i] } else { 0.0 });
             if turned {
                 // In the holder's frame, less the Coriolis and centrifugal parts of dP/dt: 2 w x P + w x (w x S).
-                let (w, p, s) = (self.state.spin, self.engine.momentum(&self.state), self.engine.first_moment(&self.state));
+                let (w, p, s) = (self.state.spin, self.space.momentum(&self.state.v), self.space.first_moment(&self.state.y));
                 let (coriolis, centrifugal) = (cross(&w, &p), cross(&w, &cross(&w, &s)));
                 let local: [f64; 3] = std::array::from_fn(|i| force[i] - 2.0 * coriolis[i] - centrifugal[i]);
                 force = apply(&rotation(&self.state.rotation), &local);
@@ -110,13 +159,10 @@ impl Simulator {
         }
         self.outputs.anchor_force
     }
-    /// The torque the sheet exerts on its holder about the pivot, from the
-    /// balance of angular momentum (`docs/method.md`, section 8):
-    /// S x g + rho_p x f_p - sum m rho x y'', less, while the holder turns at w,
-    /// 2 (w tr N - N w) - w x (J w); only z in 2D. O(r^2) in the modal space [N m].
-    pub fn anchor_torque(&mut self) -> [f64; 3] {
+
+    fn anchor_torque(&mut self) -> [f64; 3] {
         if !self.fresh.torque {
-            let driven = self.engine.acceleration_moments(&self.state);
+            let driven = self.acceleration_moments_now();
             let turned = self.turned();
             let felt = self.felt_loads();
             let d = self.scene().dim;
@@ -124,14 +170,14 @@ impl Simulator {
             let mut t = cross(&driven.first, &g);
             let f = point_load(self.loads(), &felt.point_load, self.scene());
             if let Some(node) = self.loads().load_node.filter(|_| f != [0.0; 3]) {
-                let x = self.engine.node_position(&self.state, node);
+                let x = self.node_position_now(node);
                 let arm = cross(&std::array::from_fn(|i| x[i] - self.pivot[i]), &f);
                 t = std::array::from_fn(|i| t[i] + arm[i]);
             }
             let inertial = driven.angular();
             t = std::array::from_fn(|i| t[i] - inertial[i]);
             if turned {
-                let (w, motion) = (self.state.spin, self.engine.motion(&self.state));
+                let (w, motion) = (self.state.spin, self.space.moments(&self.state.y, &self.state.v));
                 let n = &motion.flux;
                 let (nw, jw) = (apply(n, &w), apply(&motion.second, &w));
                 let gyro = cross(&w, &jw);
@@ -144,69 +190,17 @@ impl Simulator {
         }
         self.outputs.anchor_torque
     }
-    /// Coordinates of the kept (modal) or reported (full) modes.
-    pub fn modal_coordinates(&self) -> &[f64] {
-        &self.outputs.modal_coordinates
-    }
-    /// omega_i of the kept or reported modes, ascending [rad/s].
-    pub fn mode_frequencies(&self) -> &[f64] {
-        self.engine.layout().frequencies
-    }
-    /// The kept (modal) or reported (full) modes: shapes Phi (row-major n x r over the free DOFs), lambda_i.
-    pub fn mode_shapes(&self) -> Option<&ModalBasis> {
-        self.engine.modes()
-    }
-    /// Out-of-plane share and mirror symmetry of each mode of [`Self::mode_shapes`] (empty without). O(n r).
-    pub fn mode_classes(&self) -> ModeClasses {
-        self.engine.modes().map_or_else(ModeClasses::default, |b| mode_classes::classify(self.engine.scene(), b))
-    }
-    /// Every mode of [`Self::mode_shapes`] laid out on the grid as the node
-    /// outputs are, `[r][n_nodes][dim]`, 0 on held nodes (empty without). O(n r).
-    pub fn mode_grid_shapes(&self) -> Vec<f64> {
-        self.engine.modes().map_or_else(Vec::new, |b| mode_classes::grid_shapes(self.engine.scene(), b))
-    }
-    /// The spring force at generalized coordinates `y` as the space
-    /// evaluates it: Phi^T f(x* + Phi y) in the modal space (every spring,
-    /// or the cubature), f(x_rest + y) in full space. For diagnostics; the
-    /// run is not affected.
-    pub fn spring_force(&mut self, y: &[f64]) -> Result<Vec<f64>, PhysicsError> {
-        let n = self.state.len();
-        if y.len() != n {
-            return Err(PhysicsError::SnapshotLength { len: y.len(), expected: n });
-        }
-        let mut out = vec![0.0; n];
-        self.engine.spring_force(&self.state, y, &mut out);
-        Ok(out)
-    }
-    /// The costly products of the set-up (modal space only), to store and
-    /// pass to [`Self::with_setup`] later.
-    pub fn setup_data(&self) -> Option<SetupData> {
-        self.engine.setup_data()
-    }
-    /// How far the state is from the range a trained basis was trained
-    /// for ([`crate::physics::TrainedRange::distance`] of the modal
-    /// coordinates: at most 1 inside); 0 for other bases and in full
-    /// space. O(r).
-    pub fn training_range(&self) -> f64 {
-        self.engine.layout().trained.map_or(0.0, |t| t.distance(&self.state.y))
-    }
-    /// Springs one force evaluation visits: every spring, or the cubature set.
-    pub fn cubature_springs(&self) -> usize {
-        self.engine.layout().springs
-    }
-    /// 1/2 v^T M v [J].
-    pub fn kinetic_energy(&self) -> f64 {
+
+    fn kinetic_energy(&self) -> f64 {
         self.outputs.kinetic
     }
-    /// Elastic energy of the springs plus gravitational energy relative to
-    /// rest [J]: every spring, whatever the force model; computed when first
-    /// asked after a step.
-    pub fn potential_energy(&mut self) -> f64 {
+
+    fn potential_energy(&mut self) -> f64 {
         if !self.fresh.potential && self.turned() {
             // Elastic energy, and -g . sum m (X - X_rest) = -g . (m a + R S - S_rest), and -f_p . (X_p - X_p,rest).
             let (d, point) = (self.scene().dim, point_load(self.loads(), &self.loads().point_load, self.scene()));
-            let elastic = self.engine.elastic_energy(&self.state);
-            let s = apply(&rotation(&self.state.rotation), &self.engine.first_moment(&self.state));
+            let elastic = self.elastic_energy_now();
+            let s = apply(&rotation(&self.state.rotation), &self.space.first_moment(&self.state.y));
             let g: [f64; 3] = std::array::from_fn(|i| if i < d { self.loads().gravity[i] } else { 0.0 });
             let lowered: [f64; 3] = std::array::from_fn(|i| self.free_mass * self.state.anchor[i] + s[i] - self.rest_moment[i]);
             let mut potential = elastic - dot(&g, &lowered);
@@ -222,20 +216,64 @@ impl Simulator {
             // The anchor's displacement a moves every free node: -(m g + f_p) . a more.
             let (d, point) = (self.scene().dim, point_load(self.loads(), &self.loads().point_load, self.scene()));
             let shifted: f64 = (0..d).map(|i| (self.free_mass * self.loads().gravity[i] + point[i]) * self.state.anchor[i]).sum();
-            self.outputs.potential = self.engine.potential_energy(&self.state) - shifted;
+            self.outputs.potential = self.potential_energy_now() - shifted;
             self.fresh.potential = true;
         }
         self.outputs.potential
     }
-    /// The part of the physical force the basis cannot represent, relative
-    /// to the load (0 in full space); computed when first asked after a step.
-    pub fn force_residual(&mut self) -> f64 {
+
+    fn force_residual(&mut self) -> f64 {
         if !self.fresh.residual {
             let felt = self.felt_loads();
-            self.outputs.force_residual = self.engine.force_residual(&felt.gravity, &felt.point_load, &self.state);
+            self.outputs.force_residual = self.force_residual_now(&felt.gravity, &felt.point_load);
             self.fresh.residual = true;
         }
         self.outputs.force_residual
+    }
+
+    fn modal_coordinates(&self) -> &[f64] {
+        &self.outputs.modal_coordinates
+    }
+
+    fn spring_force(&mut self, y: &[f64]) -> Result<Vec<f64>, PhysicsError> {
+        let n = self.state.len();
+        if y.len() != n {
+            return Err(PhysicsError::SnapshotLength { len: y.len(), expected: n });
+        }
+        let mut out = vec![0.0; n];
+        self.space.spring_force(y, &mut self.work, &mut out);
+        self.evaluate_forces();
+        Ok(out)
+    }
+
+    fn training_range(&self) -> f64 {
+        self.space.layout().trained.map_or(0.0, |t| t.distance(&self.state.y))
+    }
+}
+
+impl<S: Readout, I: Scheme> SetUp for Run<S, I> {
+    fn mode_frequencies(&self) -> &[f64] {
+        self.space.layout().frequencies
+    }
+
+    fn mode_shapes(&self) -> Option<&ModalBasis> {
+        self.space.modes()
+    }
+
+    fn mode_classes(&self) -> ModeClasses {
+        self.space.modes().map_or_else(ModeClasses::default, |b| mode_classes::classify(self.space.scene(), b))
+    }
+
+    fn mode_grid_shapes(&self) -> Vec<f64> {
+        self.space.modes().map_or_else(Vec::new, |b| mode_classes::grid_shapes(self.space.scene(), b))
+    }
+
+    fn setup_data(&self) -> Option<SetupData> {
+        self.space.setup_data()
+    }
+
+    fn cubature_springs(&self) -> usize {
+        self.space.layout().springs
     }
 }
 

@@ -43,14 +43,9 @@ pub struct Layout<'a> {
     pub trained: Option<&'a TrainedRange>,
 }
 
-/// The equations of one space, as the schemes step them; see the module
-/// documentation. What is read from its coordinates is [`Readout`].
-pub trait Space: Send + Sized + 'static {
-    /// The loads of one run, the terms derived from them and the scratch:
-    /// the one place a run's loads live (read through `as_ref`, changed
-    /// through `as_mut` and then [`Space::apply_loads`]).
-    type Work: Send + 'static + AsRef<Loads> + AsMut<Loads>;
-
+/// What a space is, fixed at set-up: its scene, sizes and constants, the
+/// modes it keeps or reports, where its coordinates start.
+pub trait Constants {
     /// The scene the space was built on.
     fn scene(&self) -> &Scene;
     /// Sizes and constants of the space.
@@ -63,12 +58,23 @@ pub trait Space: Send + Sized + 'static {
     fn modes(&self) -> Option<&ModalBasis> {
         None
     }
-    /// The work of a run under `loads`: the loads, their terms (all zero
-    /// until [`Space::apply_loads`]) and scratch.
-    fn work(&self, loads: &Loads) -> Self::Work;
     /// The coordinates of the scene at rest, where every run starts (0
     /// unless the coordinates are measured from another point than rest).
     fn rest_coordinates(&self, y: &mut [f64]);
+}
+
+/// The equations of one space, as the schemes step them; see the module
+/// documentation. What it is is [`Constants`]; what is read from its
+/// coordinates is [`Readout`].
+pub trait Space: Constants + Send + Sized + 'static {
+    /// The loads of one run, the terms derived from them and the scratch:
+    /// the one place a run's loads live (read through `as_ref`, changed
+    /// through `as_mut` and then [`Space::apply_loads`]).
+    type Work: Send + 'static + AsRef<Loads> + AsMut<Loads>;
+
+    /// The work of a run under `loads`: the loads, their terms (all zero
+    /// until [`Space::apply_loads`]) and scratch.
+    fn work(&self, loads: &Loads) -> Self::Work;
 
     /// Derives the load terms (damping per coordinate, generalized gravity
     /// and point load) from the loads of `w`, once per load change.

@@ -16,7 +16,7 @@ use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LdltRef, LltRe
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
-use super::equations::{Diagonal, Layout, Readout, Space};
+use super::equations::{Constants, Diagonal, Layout, Readout, Space};
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::run::forces::{linearize, omega_sq_bound_full, SpringForces, SpringScratch, StiffnessPattern};
 use crate::physics::run::frame::{add_outer, cross, dot, Frame, Moments};
@@ -272,9 +272,7 @@ impl Full {
 /// Iterates of the Coriolis velocity update before a step is refused.
 const MAX_CORIOLIS_ITERATIONS: usize = 100;
 
-impl Space for Full {
-    type Work = FullWork;
-
+impl Constants for Full {
     fn scene(&self) -> &Scene {
         &self.scene
     }
@@ -294,6 +292,15 @@ impl Space for Full {
     fn modes(&self) -> Option<&ModalBasis> {
         self.reported.as_ref()
     }
+
+    /// u = 0: the full space measures from the rest positions.
+    fn rest_coordinates(&self, u: &mut [f64]) {
+        u.fill(0.0);
+    }
+}
+
+impl Space for Full {
+    type Work = FullWork;
 
     fn work(&self, loads: &Loads) -> FullWork {
         let n = self.scene.n_dofs();
@@ -321,11 +328,6 @@ impl Space for Full {
             rhs: vec![0.0; n],
             previous: vec![0.0; n],
         }
-    }
-
-    /// u = 0: the full space measures from the rest positions.
-    fn rest_coordinates(&self, u: &mut [f64]) {
-        u.fill(0.0);
     }
 
     fn apply_loads(&self, w: &mut FullWork) {

@@ -26,6 +26,6 @@ mod equations;
 mod full;
 mod modal;
 
-pub use equations::{Diagonal, Layout, Readout, Space};
+pub use equations::{Constants, Diagonal, Layout, Readout, Space};
 pub use full::Full;
 pub use modal::{basis_bound, Candidate, Cubature, Exact, ForceSetup, Modal, Modes, ReducedForce};

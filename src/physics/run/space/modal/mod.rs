@@ -30,7 +30,7 @@ pub use exact::Exact;
 pub use inertia::Inertia;
 pub use reduced::{taut_reduced_bound, ForceSetup, Modes, ReducedForce};
 
-use super::equations::{Diagonal, Layout, Readout, Space};
+use super::equations::{Constants, Diagonal, Layout, Readout, Space};
 use crate::physics::error::{PhysicsError, StepFailure};
 use crate::physics::run::forces::omega_sq_bound_full;
 use crate::physics::run::frame::{dot, Frame, Moments};
@@ -164,9 +164,7 @@ impl<F: ReducedForce> Modal<F> {
     }
 }
 
-impl<F: ReducedForce> Space for Modal<F> {
-    type Work = ModalWork<F::Work>;
-
+impl<F: ReducedForce> Constants for Modal<F> {
     fn scene(&self) -> &Scene {
         &self.scene
     }
@@ -198,6 +196,22 @@ impl<F: ReducedForce> Space for Modal<F> {
         Some(&self.modes.basis)
     }
 
+    /// q = Phi^T M (x_rest - x*): the rest positions as the basis sees them
+    /// (exact when they lie in its span, as with a static correction).
+    fn rest_coordinates(&self, q: &mut [f64]) {
+        q.fill(0.0);
+        if self.modes.at_rest {
+            return;
+        }
+        let n = self.modes.basis.n;
+        let u: Vec<f64> = (0..n).map(|k| self.scene.rest[k] - self.modes.point[k]).collect();
+        self.modes.basis.project_displacement(&self.scene.dof_mass, &u, q);
+    }
+}
+
+impl<F: ReducedForce> Space for Modal<F> {
+    type Work = ModalWork<F::Work>;
+
     fn work(&self, loads: &Loads) -> ModalWork<F::Work> {
         let r = self.modes.basis.r;
         let req =
@@ -226,18 +240,6 @@ impl<F: ReducedForce> Space for Modal<F> {
             velocity_perm_inv: vec![0; r],
             velocity_dt: f64::NAN,
         }
-    }
-
-    /// q = Phi^T M (x_rest - x*): the rest positions as the basis sees them
-    /// (exact when they lie in its span, as with a static correction).
-    fn rest_coordinates(&self, q: &mut [f64]) {
-        q.fill(0.0);
-        if self.modes.at_rest {
-            return;
-        }
-        let n = self.modes.basis.n;
-        let u: Vec<f64> = (0..n).map(|k| self.scene.rest[k] - self.modes.point[k]).collect();
-        self.modes.basis.project_displacement(&self.scene.dof_mass, &u, q);
     }
 
     fn apply_loads(&self, w: &mut Self::Work) {
