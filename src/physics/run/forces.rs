@@ -225,15 +225,24 @@ fn reduced_tangent<const D: usize>(scene: &Scene, x: &[f64], phi: &[f64], r: usi
                 g[i * r + j] = pa - pb;
             }
         }
-        for i in 0..D {
-            for j in 0..r {
-                kg[i * r + j] = (0..D).map(|m| ke[(i, m)] * g[m * r + j]).sum();
-            }
+        add_projected_block::<D>(&ke, g, r, kg, kr);
+    }
+}
+
+/// kr += G^T K_e G for one spring's block K_e (D x D) and G = Phi_a - Phi_b
+/// (D x r, row-major), with `kg` (D x r) as scratch for K_e G: the one
+/// loop of every reduced tangent (all springs here, the cubature's
+/// weighted ones in `space/modal/cubature.rs`).
+#[inline]
+pub fn add_projected_block<const D: usize>(ke: &SMatrix<f64, D, D>, g: &[f64], r: usize, kg: &mut [f64], kr: &mut [f64]) {
+    for i in 0..D {
+        for j in 0..r {
+            kg[i * r + j] = (0..D).map(|m| ke[(i, m)] * g[m * r + j]).sum();
         }
-        for col in 0..r {
-            for row in 0..r {
-                kr[col * r + row] += (0..D).map(|i| g[i * r + row] * kg[i * r + col]).sum::<f64>();
-            }
+    }
+    for col in 0..r {
+        for row in 0..r {
+            kr[col * r + row] += (0..D).map(|i| g[i * r + row] * kg[i * r + col]).sum::<f64>();
         }
     }
 }

@@ -121,29 +121,15 @@ pub struct Loads {
 
 impl Clone for Loads {
     fn clone(&self) -> Self {
-        Loads {
-            gravity: self.gravity,
-            point_load: self.point_load,
-            load_node: self.load_node,
-            anchor: self.anchor,
-            rotation: self.rotation,
-            damping_alpha: self.damping_alpha,
-            damping_beta: self.damping_beta,
-            mode_weights: self.mode_weights.clone(),
-        }
+        Loads { mode_weights: self.mode_weights.clone(), ..*self }
     }
 
-    /// Field by field, reusing the weights' buffer: a load change between
-    /// steps allocates nothing.
+    /// Reusing the weights' buffer: a load change between steps allocates
+    /// nothing. Every other field is `Copy`, so a new one needs no line here.
     fn clone_from(&mut self, source: &Self) {
-        self.gravity = source.gravity;
-        self.point_load = source.point_load;
-        self.load_node = source.load_node;
-        self.anchor = source.anchor;
-        self.rotation = source.rotation;
-        self.damping_alpha = source.damping_alpha;
-        self.damping_beta = source.damping_beta;
-        self.mode_weights.clone_from(&source.mode_weights);
+        let mut weights = std::mem::take(&mut self.mode_weights);
+        weights.clone_from(&source.mode_weights);
+        *self = Loads { mode_weights: weights, ..*source };
     }
 }
 

@@ -28,7 +28,7 @@
 
 use super::reduced::{ForceSetup, Modes, ReducedForce};
 use crate::physics::error::PhysicsError;
-use crate::physics::run::forces::{block, pull, SpringForces, SpringScratch};
+use crate::physics::run::forces::{add_projected_block, block, pull, SpringForces, SpringScratch};
 use crate::physics::setup::scene::Scene;
 use crate::physics::setup::setup_data::SpringSet;
 
@@ -213,16 +213,7 @@ impl Cubature {
         let kg = &mut w.kg;
         for ((g, d), (&wk, &l0)) in self.g.chunks_exact(D * r).zip(w.d.chunks_exact(D)).zip(self.wk.iter().zip(&self.l0)) {
             let ke = block::<D>(d.try_into().expect("D values"), wk, l0);
-            for i in 0..D {
-                for j in 0..r {
-                    kg[i * r + j] = (0..D).map(|m| ke[(i, m)] * g[m * r + j]).sum();
-                }
-            }
-            for col in 0..r {
-                for row in 0..r {
-                    kr[col * r + row] += (0..D).map(|i| g[i * r + row] * kg[i * r + col]).sum::<f64>();
-                }
-            }
+            add_projected_block::<D>(&ke, g, r, kg, kr);
         }
     }
 }

@@ -24,11 +24,13 @@ mod cubature;
 mod exact;
 mod inertia;
 mod reduced;
+mod work;
 
 pub use cubature::{Candidate, Cubature};
 pub use exact::Exact;
 pub use inertia::Inertia;
 pub use reduced::{taut_reduced_bound, ForceSetup, Modes, ReducedForce};
+pub use work::ModalWork;
 
 use super::equations::{Constants, Diagonal, Layout, Readout, Space};
 use crate::physics::error::{PhysicsError, StepFailure};
@@ -65,58 +67,6 @@ pub struct Modal<F: ReducedForce = Exact> {
     sag: [f64; 3],
     /// The range a trained basis was trained for.
     range: Option<TrainedRange>,
-}
-
-/// Load terms and scratch of a modal run.
-pub struct ModalWork<W> {
-    /// c_i = alpha + beta lambda_i.
-    damping: Vec<f64>,
-    /// The loads of the run: the one place its mode weights w_i, gravity,
-    /// point load and damping live.
-    loads: Loads,
-    /// Phi^T (M g + f_p): gravity and the point load.
-    gravity: Vec<f64>,
-    /// w_i (Phi^T (M g + f_p))_i: the part of w_i r_i that does not depend on q.
-    weighted_load: Vec<f64>,
-    /// -(M g + f_p)^T (x* - x_rest): the potential of the loads at q = 0.
-    gravity_offset: f64,
-    /// What the force model writes.
-    force: W,
-    /// Reduced tangent Phi^T K(x) Phi (column-major).
-    kr: Vec<f64>,
-    /// F = Phi^T (f + M g) of the last force evaluation, before the weights (for the error indicator).
-    generalized: Vec<f64>,
-    /// ||M g + f_p||^2 in the M^-1 norm, the load's scale of the error indicator.
-    load_scale: f64,
-    /// Newton matrix, LU-factored in place, with its row permutation.
-    jac: Mat<f64>,
-    perm: Vec<usize>,
-    perm_inv: Vec<usize>,
-    mem: MemBuffer,
-    /// The holder's frame has left its rest orientation ([`Space::turn`]).
-    turning: bool,
-    spin: [f64; 3],
-    /// The centrifugal force c0 + Kc q and the Coriolis matrix Gamma of the spin (see [`Inertia::spin_terms`]).
-    centrifugal: Vec<f64>,
-    spin_stiffness: Vec<f64>,
-    coriolis: Vec<f64>,
-    /// I (1 + dt/2 c) + dt/2 W Gamma, LU-factored, for the explicit velocity update while turning, and its dt (NaN: stale).
-    velocity: Mat<f64>,
-    velocity_perm: Vec<usize>,
-    velocity_perm_inv: Vec<usize>,
-    velocity_dt: f64,
-}
-
-impl<W> AsRef<Loads> for ModalWork<W> {
-    fn as_ref(&self) -> &Loads {
-        &self.loads
-    }
-}
-
-impl<W> AsMut<Loads> for ModalWork<W> {
-    fn as_mut(&mut self) -> &mut Loads {
-        &mut self.loads
-    }
 }
 
 impl<F: ReducedForce> Modal<F> {
