@@ -128,7 +128,7 @@ def main(argv=None):
     shown = omega[:8]
     print(f"frequencies  {' '.join(f'{w:.4g}' for w in shown)}{' ...' if len(omega) > 8 else ''} rad/s"
           f"  ({' '.join(f'{w / (2 * np.pi):.4g}' for w in shown)}{' ...' if len(omega) > 8 else ''} Hz)")
-    print(f"bottom row   sag time-averaged over the run: {-dy.mean() * 1000:.2f} mm (the undamped sheet swings about its equilibrium), "
+    print(f"bottom row   sag time-averaged over the run: {-dy.mean() * 1000:.2f} mm, "
           f"at t = {res['time'][-1]:g} s: {-dy[-1] * 1000:.2f} mm, "
           f"largest: {-dy.min() * 1000:.2f} mm at t = {res['time'][int(np.argmin(dy))]:.2f} s")
     print(f"energy       at t = {res['time'][-1]:g} s: kinetic {ke[-1]:.5g} J, potential {pe[-1]:.5g} J, "
