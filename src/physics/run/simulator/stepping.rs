@@ -379,12 +379,10 @@ impl<S: Readout, I: Scheme> Steps for Run<S, I> {
         if *loads == self.spare {
             return Ok(());
         }
-        let refused = loads.validate(self.settings.n_modes).and_then(|()| loads.validate_on(self.scene())).and_then(|()| {
-            match !I::TURNS && planar(&loads.rotation, self.scene().dim) != self.state.rotation {
-                true => Err(PhysicsError::SchemeCannotTurn { scheme: self.settings.integrator }),
-                false => Ok(()),
-            }
-        });
+        let mut refused = loads.validate(self.settings.n_modes).and_then(|()| loads.validate_on(self.scene()));
+        if refused.is_ok() && !I::TURNS && planar(&loads.rotation, self.scene().dim) != self.state.rotation {
+            refused = Err(PhysicsError::SchemeCannotTurn { scheme: self.settings.integrator });
+        }
         if let Err(e) = refused {
             std::mem::swap(self.work.as_mut(), &mut self.spare);
             return Err(e);
