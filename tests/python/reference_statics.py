@@ -76,13 +76,13 @@ class Sheet:
 
 
 def build_sheet(holder_of_node, dim, spacing=0.1, node_mass=0.01, spring_stiffness=50.0, shear_springs=True, bending_springs=False,
-                aux_stiffness=0.0, inter_holder_springs=False):
-    """The grid's springs. A spring whose ends are both held is left out, as
-    grid.rs does; with ``inter_holder_springs`` one between nodes of two
-    different holders is kept (it is stretched when they move apart)."""
-    holder = np.asarray(holder_of_node, dtype=int)
-    ny, nx = holder.shape
-    holder = holder.ravel()
+                aux_stiffness=0.0, inter_holder_springs=True):
+    """The grid's springs. A spring with both ends on one holder is left out
+    (it never changes length); one between nodes of two different holders is
+    kept (it acts when they move apart) unless ``inter_holder_springs`` is
+    False, which leaves out every spring between held nodes (grid.rs with
+    one holder)."""
+    (ny, nx), holder = np.shape(holder_of_node), np.asarray(holder_of_node, dtype=int).ravel()
     if dim not in (2, 3):
         raise ValueError("dim must be 2 or 3")
     rest = np.zeros((nx * ny, dim))

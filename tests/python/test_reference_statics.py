@@ -108,21 +108,23 @@ def pad3(v):
     return np.array([0.0, 0.0, v[0]]) if v.size == 1 else np.pad(v, (0, 3 - v.size))
 
 
+@pytest.mark.parametrize("inter", [True, False], ids=["springs-between-holders", "none-between-holders"])
 @pytest.mark.parametrize("dim", [2, 3])
-def test_several_holders_balance_the_weight_and_its_moment(dim):
-    """Three holders on the top row of a 10 x 9 sheet, the right one moved
+def test_several_holders_balance_the_weight_and_its_moment(dim, inter):
+    """Three holders on the top row of a 10 x 6 sheet, the right one moved
     out by a fifth of its width (0.18 m) and turned, the left one moved out
     by half that and turned about a tilted axis, the middle one lifted: the
     solve converges from rest, the holders' forces add up to
     the weight of the free nodes and the load, and their torques, carried
-    to one point, to the moment of those about it."""
-    nx, ny = 10, 9
+    to one point, to the moment of those about it; with the springs between
+    two holders kept (the default) or left out."""
+    nx, ny = 10, 6
     held = np.zeros((ny, nx), dtype=int)
     held[0, :3], held[0, 3:7], held[0, 7:] = 1, 2, 3
     placements = {1: ((-0.09, 0.0, 0.0), (0.0, 0.1, 0.3)), 2: ((0.0, 0.02, 0.01), 0.0), 3: ((0.18, -0.03, 0.0), (0.0, 0.0, -0.3))}
     gravity, load, load_node = (0.5, -9.81, 0.3), (0.4, -1.0, 0.6), (2, 3)
     eq = solve_statics(held, dim, placements=placements, gravity=gravity, load=load, load_row=load_node[0], load_column=load_node[1],
-                       bending_springs=True, aux_stiffness=0.05 if dim == 3 else 0.0)
+                       bending_springs=True, aux_stiffness=0.05 if dim == 3 else 0.0, inter_holder_springs=inter)
     x = np.zeros((ny, nx, 3))
     x[..., :dim] = eq.positions
     g = np.zeros(3)
@@ -135,7 +137,8 @@ def test_several_holders_balance_the_weight_and_its_moment(dim):
     forces = sum(pad3(eq.forces[k]) for k in eq.forces)
     torques = sum(pad3(eq.torques[k]) + np.cross(pad3(eq.pivots[k]), pad3(eq.forces[k])) for k in eq.forces)
     scale = eq.load_scale
-    print(f"{dim}D, 3 holders: {eq.iterations} Newton iterations, residual {eq.residual:.1e}, stable {eq.stable}; "
+    print(f"{dim}D, 3 holders, springs between them {'kept' if inter else 'left out'}: "
+          f"{eq.iterations} Newton iterations, residual {eq.residual:.1e}, stable {eq.stable}; "
           f"|sum F_k - weight - load| {np.abs(forces - weight).max() / scale:.1e}, "
           f"|sum of the moments - moment of weight and load| {np.abs(torques - moment).max() / scale:.1e} of the load {scale:.3f} N; "
           f"forces {[np.round(eq.forces[k], 4).tolist() for k in eq.forces]}")
@@ -166,12 +169,12 @@ def test_one_holder_split_in_parts_that_move_together(dim):
     dx = np.abs(split.positions - ref.positions).max()
     df = np.abs(split.forces[1] + split.forces[2] - ref.forces[1]).max() / ref.load_scale
     dt = np.abs(moved - pad3(ref.torques[1])).max() / ref.load_scale
-    # the springs between the two holders keep their rest length: kept or left out, the same
-    kept = solve_statics(two, dim, placements={1: (a, theta), 2: (a2, theta)}, inter_holder_springs=True, **kw)
+    # the springs between the two holders keep their rest length: left out or kept (the default), the same
+    kept = solve_statics(two, dim, placements={1: (a, theta), 2: (a2, theta)}, inter_holder_springs=False, **kw)
     dk = max(np.abs(kept.positions - split.positions).max(), *(np.abs(kept.forces[k] - split.forces[k]).max() for k in (1, 2)))
     # started from its own solution, Newton is done at once
     again = solve_statics(two, dim, placements={1: (a, theta), 2: (a2, theta)}, guess=split.positions, **kw)
     print(f"{dim}D split holder: positions {dx:.1e} m, forces {df:.1e}, torques {dt:.1e} of the load; "
-          f"springs between the holders kept: {dk:.1e}; from its own solution: {again.iterations} iteration(s)")
+          f"springs between the holders left out: {dk:.1e}; from its own solution: {again.iterations} iteration(s)")
     assert dx < 1e-12 and df < 1e-12 and dt < 1e-12 and dk < 1e-12
     assert again.iterations <= 1 and np.abs(again.positions - split.positions).max() < 1e-14
