@@ -13,6 +13,8 @@ mod counting;
 mod generate;
 #[path = "../modelDescription/generate/xml.rs"]
 mod model_description_xml;
+#[path = "../modelDescription/generate/terminals.rs"]
+mod terminals_and_icons_xml;
 
 mod anchor;
 mod bake;
@@ -37,6 +39,7 @@ mod physics;
 mod point_load;
 mod predictability;
 mod stability;
+mod terminals;
 mod trained;
 mod trajectories;
 mod trigonometric;

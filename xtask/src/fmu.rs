@@ -2,7 +2,9 @@
 //!
 //! Builds the cdylib in release mode and packs the FMU: modelDescription.xml
 //! (generated from modelDescription/variables.toml with the chosen start
-//! values), binaries/x86_64-linux/ModalMassSpring.so, documentation/index.html
+//! values), terminalsAndIcons/terminalsAndIcons.xml (the holders and the load
+//! node as terminals, from the same table: modelDescription/generate/terminals.rs),
+//! binaries/x86_64-linux/ModalMassSpring.so, documentation/index.html
 //! and resources/startValues.txt (the same start values, read by the binary).
 //! With `--bake`, also resources/setup.bin: the modal set-up of those start
 //! values (basis, equilibrium, cubature set), computed once here by the
@@ -105,6 +107,7 @@ pub fn main(args: &[String]) -> Result<(), String> {
     }
 
     let xml = spec.model_description_xml(&overrides)?;
+    let terminals = spec.terminals_and_icons_xml()?;
     let title = match &o.scene {
         Some(s) => format!("{} ({s})", spec.model_name),
         None => spec.model_name.clone(),
@@ -136,6 +139,7 @@ pub fn main(args: &[String]) -> Result<(), String> {
     let baked = if o.bake { bake(&root, &target, &starts)? } else { None };
     let mut entries: Vec<(String, &[u8])> = vec![
         ("modelDescription.xml".into(), xml.as_bytes()),
+        ("terminalsAndIcons/terminalsAndIcons.xml".into(), terminals.as_bytes()),
         (format!("binaries/{PLATFORM}/{}.so", spec.model_identifier), &binary),
         ("documentation/index.html".into(), html.as_bytes()),
         ("resources/startValues.txt".into(), starts.as_bytes()),
