@@ -161,7 +161,7 @@ fn values_are_checked_before_they_are_stored() {
     f.expect_error(f.set_f64(vr::SPACING, &[0.0]), "spacing must be positive");
     f.expect_error(f.set_u64(vr::DIMENSION, 4), "above max");
     f.expect_error(f.set_u64(vr::NX, 0), "below min");
-    f.expect_error(f.set_i64(vr::FIXED_NODES, 3), "not an enumeration value");
+    f.expect_error(f.set_i64(vr::FIXED_NODES, 4), "not an enumeration value");
     f.expect_error(f.set_f64(999, &[1.0]), "unknown value reference");
     f.expect_error(f.set_i64(vr::GRAVITY, 1), "wrong type");
     let mut x = 0u64;
@@ -492,6 +492,21 @@ fn ranges_are_enforced_by_the_setters() {
                     assert_eq!(f.set_f64(v.vr, &x), OK);
                     tried += 1;
                 }
+            }
+            Type::UInt64 if !v.dims.is_empty() => {
+                // holderOfNode, one per node: every value checked.
+                let n = 100;
+                let x: Vec<u64> = vec![0; n];
+                for bad in [v.max.unwrap() as u64 + 1, u64::MAX] {
+                    let mut y = x.clone();
+                    y[n - 1] = bad;
+                    f.expect_error(unsafe { fmi3SetUInt64(f.inst, &v.vr, 1, y.as_ptr(), n) }, &format!("{} = {bad}", v.name));
+                }
+                for good in [v.min.unwrap() as u64, v.max.unwrap() as u64, 0] {
+                    let y = vec![good; n];
+                    assert_eq!(unsafe { fmi3SetUInt64(f.inst, &v.vr, 1, y.as_ptr(), n) }, OK, "{} = {good}: {:?}", v.name, f.messages());
+                }
+                tried += 1;
             }
             Type::UInt64 => {
                 let lo = v.min.unwrap() as u64;

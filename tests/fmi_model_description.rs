@@ -135,7 +135,7 @@ fn defaults_are_paper_2d_top_row() {
 const WITH_INPUT: &str = r#"
 [[variables]]
 name = "push"
-vr = 90
+vr = 990
 type = "Float64"
 causality = "input"
 variability = "continuous"
@@ -145,7 +145,7 @@ description = "A test input"
 
 [[variables]]
 name = "reading"
-vr = 91
+vr = 991
 type = "Float64"
 causality = "output"
 variability = "continuous"
@@ -154,7 +154,7 @@ description = "An output that depends on no input directly"
 
 [[variables]]
 name = "echo"
-vr = 92
+vr = 992
 type = "Float64"
 causality = "output"
 variability = "continuous"
@@ -163,7 +163,7 @@ description = "An output that depends on the input directly"
 
 [[variables]]
 name = "silent"
-vr = 93
+vr = 993
 type = "Float64"
 causality = "output"
 variability = "continuous"
@@ -180,12 +180,12 @@ fn spec_with_input() -> Result<generate::Spec, String> {
 fn inputs_are_generated_end_to_end() {
     let spec = spec_with_input().unwrap();
     let xml = spec.model_description_xml(&BTreeMap::new()).unwrap();
-    assert!(xml.contains(r#"name="push" valueReference="90" description="A test input" causality="input" variability="continuous""#), "{xml}");
+    assert!(xml.contains(r#"name="push" valueReference="990" description="A test input" causality="input" variability="continuous""#), "{xml}");
     assert!(attribute(&xml, "push", "start") == Some(0.0));
-    assert!(xml.contains(r#"<Output valueReference="91" dependencies=""/>"#), "{xml}");
-    assert!(xml.contains(r#"<Output valueReference="92" dependencies="90"/>"#), "{xml}");
+    assert!(xml.contains(r#"<Output valueReference="991" dependencies=""/>"#), "{xml}");
+    assert!(xml.contains(r#"<Output valueReference="992" dependencies="990"/>"#), "{xml}");
     // Outputs that declare nothing depend on every input.
-    assert!(xml.contains(r#"<Output valueReference="93"/>"#), "{xml}");
+    assert!(xml.contains(r#"<Output valueReference="993"/>"#), "{xml}");
     let md = fmi_rs::model_description::fmi3::ModelDescription::from_string(&xml).unwrap();
     let problems: Vec<String> = md.validate().into_iter().map(|p| p.message).collect();
     assert!(problems.is_empty(), "{problems:#?}");
@@ -195,7 +195,7 @@ fn inputs_are_generated_end_to_end() {
         assert!(problems.is_empty(), "{problems:#?}");
     }
     let rust = spec.rust_source();
-    assert!(rust.contains(r#"name: "push", vr: 90, ty: Type::Float64, causality: Causality::Input"#), "{rust}");
+    assert!(rust.contains(r#"name: "push", vr: 990, ty: Type::Float64, causality: Causality::Input"#), "{rust}");
     // An input is set by the host, so it has a start value and a place in startValues.txt.
     assert!(spec.start_values_text(&BTreeMap::new()).unwrap().contains("\npush 0.0\n"));
     let broken = WITH_INPUT.replacen("start = 0.0\n", "", 1);
@@ -232,7 +232,7 @@ fn every_output_declares_its_dependencies_on_the_point_load() {
         assert!(xml.contains(&want), "{}: {want} not in the model description", v.name);
         outputs += 1;
     }
-    assert_eq!(outputs, 19);
+    assert_eq!(outputs, 37);
 }
 
 #[test]

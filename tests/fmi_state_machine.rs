@@ -304,6 +304,7 @@ fn size(f: &Fmu, r: u32) -> usize {
         vr::GRAVITY => 3,
         vr::MODE_SHAPES => modes * nx * ny * d,
         vr::SPRING_NEIGHBOURS => nx * ny * 6,
+        vr::HOLDER_OF_NODE => nx * ny,
         _ => 1,
     }
 }

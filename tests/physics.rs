@@ -31,6 +31,7 @@ fn state(flat: Vec<f64>) -> State {
         anchor_rate: [0.0; 3],
         rotation: [0.0; 3],
         spin: [0.0; 3],
+        holders: Default::default(),
     }
 }
 

@@ -32,6 +32,7 @@ mod fmi_threads;
 mod fmi_twins;
 mod glue_is_generic;
 mod holder;
+mod holders;
 mod layers;
 mod no_alloc;
 mod no_alloc_abi;

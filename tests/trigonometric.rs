@@ -157,6 +157,7 @@ struct Linear {
 
 struct LinearWork {
     loads: Loads,
+    slots: Vec<f64>,
     damping: Vec<f64>,
     load: Vec<f64>,
 }
@@ -175,7 +176,8 @@ impl AsMut<Loads> for LinearWork {
 
 impl Linear {
     fn new(lambda: &[f64], load: &[f64]) -> Self {
-        let scene = Scene { dim: 2, n_nodes: 1, n_free: 1, slot_of_node: vec![0], rest: vec![0.0, 0.0], dof_mass: vec![1.0, 1.0], springs: vec![] };
+        let scene =
+            Scene { dim: 2, n_nodes: 1, n_free: 1, slot_of_node: vec![0], rest: vec![0.0, 0.0], dof_mass: vec![1.0, 1.0], springs: vec![], holders: vec![] };
         Linear {
             scene,
             lambda: lambda.to_vec(),
@@ -205,7 +207,7 @@ impl Space for Linear {
     type Work = LinearWork;
 
     fn work(&self, loads: &Loads) -> LinearWork {
-        LinearWork { loads: loads.clone(), damping: vec![0.0; self.lambda.len()], load: vec![0.0; self.lambda.len()] }
+        LinearWork { slots: self.scene.rest.clone(), loads: loads.clone(), damping: vec![0.0; self.lambda.len()], load: vec![0.0; self.lambda.len()] }
     }
 
     fn apply_loads(&self, w: &mut LinearWork) {
@@ -213,6 +215,10 @@ impl Space for Linear {
             w.damping[i] = w.loads.damping_alpha + w.loads.damping_beta * self.lambda[i];
             w.load[i] = w.loads.mode_weights[i] * self.load[i];
         }
+    }
+
+    fn slots_mut<'w>(&self, w: &'w mut LinearWork) -> &'w mut [f64] {
+        &mut w.slots
     }
 
     fn force(&self, y: &[f64], w: &mut LinearWork, h: &mut [f64]) {

@@ -18,7 +18,12 @@ impl Spec {
         let cats: Vec<String> = self.log_categories.iter().map(|c| format!("{:?}", c.name)).collect();
         let _ = writeln!(r, "pub const LOG_CATEGORIES: &[&str] = &[{}];", cats.join(", "));
         let _ = writeln!(r, "/// Identifies the variable layout in serialized FMU states.");
-        let _ = writeln!(r, "pub const LAYOUT_FINGERPRINT: u64 = {:#018x};", self.fingerprint());
+        let _ = writeln!(r, "pub const LAYOUT_FINGERPRINT: u64 = {:#018x};", self.fingerprint(u32::MAX));
+        let _ = writeln!(r, "/// The variable layout of serialized-state format 5 (the variables without `since_format`).");
+        let _ = writeln!(r, "pub const LAYOUT_FINGERPRINT_FORMAT5: u64 = {:#018x};", self.fingerprint(5));
+        let since: Vec<String> = self.variables.iter().filter(|v| v.since_format.is_some()).map(|v| v.vr.to_string()).collect();
+        let _ = writeln!(r, "/// Value references of the variables serialized-state format 5 lacks.");
+        let _ = writeln!(r, "pub const SINCE_FORMAT6: &[u32] = &[{}];", since.join(", "));
         let _ = writeln!(r, "/// Value references.\npub mod vr {{");
         for v in &self.variables {
             let _ = writeln!(r, "    pub const {}: u32 = {};", screaming(&v.name), v.vr);
@@ -141,9 +146,10 @@ impl Spec {
         r
     }
 
-    fn fingerprint(&self) -> u64 {
+    /// FNV-1a of the layout of the variables serialized-state format `format` has.
+    fn fingerprint(&self, format: u32) -> u64 {
         let mut s = String::new();
-        for v in &self.variables {
+        for v in self.variables.iter().filter(|v| v.since_format.is_none_or(|f| f <= format)) {
             let _ = write!(s, "{}|{}|{}|{}|{}|{:?};", v.name, v.vr, v.ty, v.causality, v.variability, v.dims());
         }
         let mut h: u64 = 0xcbf2_9ce4_8422_2325;

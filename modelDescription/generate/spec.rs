@@ -91,6 +91,10 @@ pub struct Variable {
     /// communication point (ModelStructure `dependencies`); absent: every input.
     #[serde(default)]
     pub depends_on: Option<Vec<String>>,
+    /// The serialized-state format that added it (absent: format 5 or
+    /// earlier): states of an earlier format, which lack it, start it at its start value.
+    #[serde(default)]
+    pub since_format: Option<u32>,
 }
 
 /// One array dimension: a fixed size or the value of a structural parameter.

@@ -75,8 +75,9 @@ pub trait Model {
     /// Appends `s` to a serialized FMU state.
     fn write_snapshot(s: &Self::Snapshot, out: &mut Vec<u8>);
 
-    /// Reads what [`Model::write_snapshot`] wrote.
-    fn read_snapshot(r: &mut Reader) -> Result<Self::Snapshot, String>;
+    /// Reads what [`Model::write_snapshot`] wrote, in serialized-state
+    /// format `format` (the current one, or an older one still read).
+    fn read_snapshot(r: &mut Reader, format: u32) -> Result<Self::Snapshot, String>;
 
     /// Refuses a deserialized snapshot that does not belong to the values `p`.
     fn check_snapshot(s: &Self::Snapshot, p: &Params) -> Result<(), String>;

@@ -19,15 +19,21 @@ use super::model::Model;
 use super::params::Params;
 use super::state_machine::Mode;
 use super::values::check_value;
-use super::variables::{index_of, LAYOUT_FINGERPRINT, VARIABLES};
+use super::variables::{index_of, LAYOUT_FINGERPRINT, LAYOUT_FINGERPRINT_FORMAT5, SINCE_FORMAT6, VARIABLES};
 use crate::TheModel;
 
 pub const MAGIC: &[u8; 8] = b"MMSFMU3S";
 /// 1: FNV-1a checksum, no stop time; 2: CRC-32, stop time; 3: the
 /// simulator state as time and three arrays (y, y', y'') instead of one
 /// concatenated array; 4: the point load and its node among the loads,
-/// the anchor's position and rate in the state and its target among the loads.
-pub const VERSION: u32 = 5;
+/// the anchor's position and rate in the state and its target among the loads;
+/// 5: the holder's orientation and spin, and its target; 6: holders 2 to 4
+/// (their motions in the state, their targets among the loads) and the
+/// variables that set them. Format 5 is still read: its holders 2 to 4 are
+/// at rest and the variables it lacks take their start values.
+pub const VERSION: u32 = 6;
+/// The oldest format read.
+pub const OLDEST: u32 = 5;
 /// Bytes before the payload.
 pub const HEADER: usize = 8 + 4 + 8 + 8;
 /// Bytes after the payload.
@@ -93,14 +99,14 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
         return Err("not a serialized state of this FMU (bad magic)".into());
     }
     let version = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
-    if version < VERSION {
-        return Err(format!("serialized state format {version} was written by an older version of this FMU; this version reads format {VERSION} only"));
+    if version < OLDEST {
+        return Err(format!("serialized state format {version} was written by an older version of this FMU; this version reads formats {OLDEST} to {VERSION}"));
     }
-    if version != VERSION {
-        return Err(format!("serialized state format {version}, this FMU reads {VERSION}"));
+    if version > VERSION {
+        return Err(format!("serialized state format {version}, this FMU reads formats {OLDEST} to {VERSION}"));
     }
     let fp = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
-    if fp != LAYOUT_FINGERPRINT {
+    if fp != if version == VERSION { LAYOUT_FINGERPRINT } else { LAYOUT_FINGERPRINT_FORMAT5 } {
         return Err("serialized state of a different model description".into());
     }
     let len = u64::from_le_bytes(bytes[20..28].try_into().unwrap());
@@ -142,6 +148,11 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
     for (i, v) in VARIABLES.iter().enumerate() {
         if v.holds_value() {
             if !seen[i] {
+                if version < VERSION && SINCE_FORMAT6.contains(&v.vr) {
+                    // Sized below, once the structural parameters are known.
+                    params.values[i] = v.start.get(..1).unwrap_or(&[0.0]).to_vec();
+                    continue;
+                }
                 return Err(format!("{} is missing", v.name));
             }
             // Array sizes are checked below, once the structural parameters are known.
@@ -155,13 +166,17 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
     }
     for (i, v) in VARIABLES.iter().enumerate() {
         let want = if v.holds_value() { params.size_of(v) } else { 0 };
+        if !seen[i] && v.holds_value() && !v.dims.is_empty() {
+            let fill = params.values[i][0];
+            params.values[i] = vec![fill; want];
+        }
         if params.values[i].len() != want {
             return Err(format!("{} holds {} values, expected {want}", v.name, params.values[i].len()));
         }
     }
     let snapshot = match r.u8()? {
         0 => None,
-        1 => Some(TheModel::read_snapshot(&mut r)?),
+        1 => Some(TheModel::read_snapshot(&mut r, version)?),
         _ => return Err("bad snapshot flag".into()),
     };
     if !r.is_done() {

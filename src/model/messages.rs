@@ -4,7 +4,7 @@
 use crate::fmi::params::Params;
 use crate::fmi::variables::vr;
 use crate::options::{Integrator, Reduction};
-use crate::physics::{PhysicsError, Quantity, StepFailure};
+use crate::physics::{HolderProblem, PhysicsError, Quantity, StepFailure};
 
 /// The variable that sets `q`.
 pub fn variable(q: Quantity) -> &'static str {
@@ -30,6 +30,8 @@ pub fn variable(q: Quantity) -> &'static str {
         Quantity::TrainingScale => "trainingScale",
         Quantity::TrainingTilt => "trainingTilt",
         Quantity::TrainingTime => "trainingTime",
+        Quantity::Holders => "nHolders",
+        Quantity::HolderMotion => "anchor{k}X ... anchor{k}RZ",
     }
 }
 
@@ -138,9 +140,40 @@ pub fn describe(e: &PhysicsError, p: &Params) -> String {
             integrator(Integrator::NewmarkExplicit),
             integrator(Integrator::NewmarkImplicit),
         ),
+        Holders(problem) => holders(problem, p),
         SnapshotLength { len, expected } => format!("the state holds {len} values per array, this scene needs {expected}"),
         SnapshotNotFinite => "the state holds non-finite values".into(),
     }
+}
+
+/// Why the held nodes cannot be split as asked, in the variables' names.
+fn holders(problem: &HolderProblem, p: &Params) -> String {
+    let n = p.scalar(vr::N_HOLDERS);
+    match problem {
+        HolderProblem::PatternLength { len, expected } => format!("holderOfNode has {len} values, the grid nx * ny has {expected} nodes"),
+        HolderProblem::IdTooLarge { row, col, id, holders } => {
+            format!("holderOfNode[{row}][{col}] = {id} names a holder beyond nHolders = {holders}: use 0 (free) to {holders}")
+        }
+        HolderProblem::NoNode { holder } => format!(
+            "holder {holder} holds no node (nHolders = {n}, fixedNodes = {}): {}",
+            fixed_name(p),
+            if p.scalar(vr::FIXED_NODES) == 3.0 { "give it nodes in holderOfNode or lower nHolders" } else { "lower nHolders" }
+        ),
+        HolderProblem::NoHeldNode => "fixedNodes = custom and holderOfNode holds no node: the sheet would fall; give at least one node a holder".into(),
+        HolderProblem::TooFewColumns { holders, columns } => format!(
+            "nHolders = {holders} cannot split the {columns} held columns of fixedNodes = {} among them (each holder needs a column): \
+             lower nHolders, or use fixedNodes = custom with holderOfNode",
+            fixed_name(p)
+        ),
+        HolderProblem::Absent { holder, holders } => {
+            format!("anchor{holder}X ... anchor{holder}RZ move holder {holder}, and nHolders = {holders}: only 0 is accepted for a holder that does not exist")
+        }
+        HolderProblem::Cubature => "forceEvaluation = cubature chooses its springs for one holder; with nHolders > 1 use forceEvaluation = exact".into(),
+    }
+}
+
+fn fixed_name(p: &Params) -> &'static str {
+    crate::options::FixedNodes::from_value(p.scalar(vr::FIXED_NODES) as i64).map_or("?", |f| f.name())
 }
 
 fn failure(cause: &StepFailure) -> String {
@@ -156,6 +189,11 @@ fn failure(cause: &StepFailure) -> String {
             "the holder's angular velocity changes by {rate:e} rad/s at the start of the step (anchorRX, anchorRY, anchorRZ): the \
              sheet, reaching {reach:e} m from the pivot, would move relative to the holder by more than half the spacing per internal \
              step of {dt:e} s (limit {limit:e} rad/s); turn the holder in smaller steps, or lower maxInternalStep"
+        ),
+        StepFailure::HolderTooFast { holder, speed, limit, dt } => format!(
+            "holder {holder}'s velocity changes by {speed:e} m/s at the start of the step (anchor{holder}X ... anchor{holder}RZ): the \
+             sheet next to it would move relative to it by more than half the spacing per internal step of {dt:e} s (limit {limit:e} \
+             m/s); move the holder in smaller steps, or lower maxInternalStep"
         ),
         StepFailure::CoriolisNotConverged { .. } => format!("{cause}; lower maxInternalStep"),
         StepFailure::NewtonNotConverged { iterations, dt } => {

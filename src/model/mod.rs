@@ -27,6 +27,7 @@ use crate::physics::{ModeClasses, Simulator, Snapshot};
 use crate::status::{OK, WARNING};
 
 pub use crate::fmi::params::Params;
+use to_physics::HOLDER_OUTPUTS;
 
 /// The mass-spring sheet of the model description, as one instance runs it.
 pub struct MassSpring {
@@ -187,9 +188,14 @@ impl Model for MassSpring {
             vr::LOAD_NODE_V_X | vr::LOAD_NODE_V_Y | vr::LOAD_NODE_V_Z => {
                 Computed::Scalar(component(sim.load_node_velocity(), (r - vr::LOAD_NODE_V_X) as usize))
             }
-            vr::ANCHOR_FORCE_X | vr::ANCHOR_FORCE_Y | vr::ANCHOR_FORCE_Z => Computed::Scalar(sim.anchor_force()[(r - vr::ANCHOR_FORCE_X) as usize]),
-            vr::ANCHOR_TORQUE_X | vr::ANCHOR_TORQUE_Y | vr::ANCHOR_TORQUE_Z => Computed::Scalar(sim.anchor_torque()[(r - vr::ANCHOR_TORQUE_X) as usize]),
-            _ => unreachable!("value reference {r} is not computed"),
+            _ => {
+                let (k, i) = HOLDER_OUTPUTS
+                    .iter()
+                    .enumerate()
+                    .find_map(|(k, vrs)| vrs.iter().position(|&v| v == r).map(|i| (k, i)))
+                    .unwrap_or_else(|| unreachable!("value reference {r} is not computed"));
+                Computed::Scalar(if i < 3 { sim.holder_force(k)[i] } else { sim.holder_torque(k)[i - 3] })
+            }
         }
     }
 
@@ -285,8 +291,8 @@ impl Model for MassSpring {
         state_bytes::write(s, out)
     }
 
-    fn read_snapshot(r: &mut Reader) -> Result<Snapshot, String> {
-        state_bytes::read(r)
+    fn read_snapshot(r: &mut Reader, format: u32) -> Result<Snapshot, String> {
+        state_bytes::read(r, format)
     }
 
     fn check_snapshot(s: &Snapshot, p: &Params) -> Result<(), String> {

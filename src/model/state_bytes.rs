@@ -1,11 +1,13 @@
 //! The simulator's part of a serialized FMU state (the payload's tail in
-//! [`crate::fmi::serialize`]): time, y, y', y'', the anchor and its rate, the holder's
-//! orientation and spin, then the loads: gravity, point load, load node,
-//! anchor and holder targets, damping,
-//! weights.
+//! [`crate::fmi::serialize`]): time, y, y', y'', the anchor and its rate,
+//! the holder's orientation and spin, then (format 6) per holder 2 to 4
+//! its displacement, velocity, rotation vector and spin; then the loads:
+//! gravity, point load, load node, anchor and holder targets, (format 6)
+//! per holder 2 to 4 its displacement and rotation targets, damping,
+//! weights. Format 5 has no holders 2 to 4: they are at rest.
 
 use crate::bytes::{put_f64, put_f64s, put_u64, Reader};
-use crate::physics::{Loads, Snapshot, State};
+use crate::physics::{Loads, Motion, Pose, Snapshot, State, OTHER_HOLDERS};
 
 pub fn write(snap: &Snapshot, p: &mut Vec<u8>) {
     let s = &snap.state;
@@ -14,31 +16,52 @@ pub fn write(snap: &Snapshot, p: &mut Vec<u8>) {
     put_f64s(p, &s.v);
     put_f64s(p, &s.a);
     s.anchor.iter().chain(&s.anchor_rate).chain(&s.rotation).chain(&s.spin).for_each(|x| put_f64(p, *x));
+    for m in &s.holders {
+        m.anchor.iter().chain(&m.anchor_rate).chain(&m.rotation).chain(&m.spin).for_each(|x| put_f64(p, *x));
+    }
     let l = &snap.loads;
     l.gravity.iter().for_each(|g| put_f64(p, *g));
     l.point_load.iter().for_each(|f| put_f64(p, *f));
     put_u64(p, l.load_node.map_or(u64::MAX, |n| n as u64));
     l.anchor.iter().chain(&l.rotation).for_each(|a| put_f64(p, *a));
+    for h in &l.holders {
+        h.anchor.iter().chain(&h.rotation).for_each(|a| put_f64(p, *a));
+    }
     put_f64(p, l.damping_alpha);
     put_f64(p, l.damping_beta);
     put_f64s(p, &l.mode_weights);
 }
 
-pub fn read(r: &mut Reader) -> Result<Snapshot, String> {
+fn vector(r: &mut Reader) -> Result<[f64; 3], String> {
+    Ok([r.f64()?, r.f64()?, r.f64()?])
+}
+
+pub fn read(r: &mut Reader, format: u32) -> Result<Snapshot, String> {
+    let holders = format >= 6;
     let (time, y, v, a) = (r.f64()?, r.f64s()?, r.f64s()?, r.f64s()?);
-    let (anchor, anchor_rate) = ([r.f64()?, r.f64()?, r.f64()?], [r.f64()?, r.f64()?, r.f64()?]);
-    let (rotation, spin) = ([r.f64()?, r.f64()?, r.f64()?], [r.f64()?, r.f64()?, r.f64()?]);
-    let state = State { time, y, v, a, anchor, anchor_rate, rotation, spin };
-    let gravity = [r.f64()?, r.f64()?, r.f64()?];
-    let point_load = [r.f64()?, r.f64()?, r.f64()?];
+    let (anchor, anchor_rate, rotation, spin) = (vector(r)?, vector(r)?, vector(r)?, vector(r)?);
+    let mut motions = [Motion::default(); OTHER_HOLDERS];
+    if holders {
+        for m in &mut motions {
+            *m = Motion { anchor: vector(r)?, anchor_rate: vector(r)?, rotation: vector(r)?, spin: vector(r)? };
+        }
+    }
+    let state = State { time, y, v, a, anchor, anchor_rate, rotation, spin, holders: motions };
+    let gravity = vector(r)?;
+    let point_load = vector(r)?;
     let load_node = match r.u64()? {
         u64::MAX => None,
         n => Some(usize::try_from(n).map_err(|_| "load node out of range".to_string())?),
     };
-    let anchor = [r.f64()?, r.f64()?, r.f64()?];
-    let rotation = [r.f64()?, r.f64()?, r.f64()?];
-    if !anchor.iter().chain(&rotation).all(|a| a.is_finite()) {
-        return Err("the anchor's or the holder's target holds non-finite values".into());
+    let (anchor, rotation) = (vector(r)?, vector(r)?);
+    let mut poses = [Pose::default(); OTHER_HOLDERS];
+    if holders {
+        for p in &mut poses {
+            *p = Pose { anchor: vector(r)?, rotation: vector(r)? };
+        }
+    }
+    if !anchor.iter().chain(&rotation).chain(poses.iter().flat_map(|p| p.anchor.iter().chain(&p.rotation))).all(|a| a.is_finite()) {
+        return Err("a holder's target holds non-finite values".into());
     }
     let damping_alpha = r.f64()?;
     let damping_beta = r.f64()?;
@@ -49,5 +72,6 @@ pub fn read(r: &mut Reader) -> Result<Snapshot, String> {
     if state.v.len() != state.y.len() || state.a.len() != state.y.len() {
         return Err(format!("the simulator state holds arrays of {}, {} and {} values", state.y.len(), state.v.len(), state.a.len()));
     }
-    Ok(Snapshot { state, loads: Loads { gravity, point_load, load_node, anchor, rotation, damping_alpha, damping_beta, mode_weights } })
+    let loads = Loads { gravity, point_load, load_node, anchor, rotation, holders: poses, damping_alpha, damping_beta, mode_weights };
+    Ok(Snapshot { state, loads })
 }

@@ -8,6 +8,21 @@ use crate::measures::twin_offset;
 use crate::options::{FixedNodes, ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction};
 use crate::physics::{Grid, Loads, PhysicsError, Settings, SetupData, Simulator, TrainingProgram};
 
+/// Holders 2, 3, 4: their displacement x, y, z and rotation vector x, y, z.
+pub const HOLDER_INPUTS: [[u32; 6]; 3] = [
+    [vr::ANCHOR2_X, vr::ANCHOR2_Y, vr::ANCHOR2_Z, vr::ANCHOR2_R_X, vr::ANCHOR2_R_Y, vr::ANCHOR2_R_Z],
+    [vr::ANCHOR3_X, vr::ANCHOR3_Y, vr::ANCHOR3_Z, vr::ANCHOR3_R_X, vr::ANCHOR3_R_Y, vr::ANCHOR3_R_Z],
+    [vr::ANCHOR4_X, vr::ANCHOR4_Y, vr::ANCHOR4_Z, vr::ANCHOR4_R_X, vr::ANCHOR4_R_Y, vr::ANCHOR4_R_Z],
+];
+
+/// Per holder (1 to 4): the force x, y, z and the torque x, y, z the sheet exerts on it.
+pub const HOLDER_OUTPUTS: [[u32; 6]; 4] = [
+    [vr::ANCHOR_FORCE_X, vr::ANCHOR_FORCE_Y, vr::ANCHOR_FORCE_Z, vr::ANCHOR_TORQUE_X, vr::ANCHOR_TORQUE_Y, vr::ANCHOR_TORQUE_Z],
+    [vr::ANCHOR2_FORCE_X, vr::ANCHOR2_FORCE_Y, vr::ANCHOR2_FORCE_Z, vr::ANCHOR2_TORQUE_X, vr::ANCHOR2_TORQUE_Y, vr::ANCHOR2_TORQUE_Z],
+    [vr::ANCHOR3_FORCE_X, vr::ANCHOR3_FORCE_Y, vr::ANCHOR3_FORCE_Z, vr::ANCHOR3_TORQUE_X, vr::ANCHOR3_TORQUE_Y, vr::ANCHOR3_TORQUE_Z],
+    [vr::ANCHOR4_FORCE_X, vr::ANCHOR4_FORCE_Y, vr::ANCHOR4_FORCE_Z, vr::ANCHOR4_TORQUE_X, vr::ANCHOR4_TORQUE_Y, vr::ANCHOR4_TORQUE_Z],
+];
+
 impl Params {
     /// The start values of the canonical scene `name` (the `[scenes.NAME]`
     /// tables of `modelDescription/variables.toml`).
@@ -38,6 +53,8 @@ impl Params {
             bending_springs: self.scalar(vr::BENDING_SPRINGS) != 0.0,
             aux_stiffness: self.scalar(vr::AUX_STIFFNESS),
             fixed_nodes: self.enumeration(vr::FIXED_NODES, FixedNodes::from_value),
+            holders: self.count(vr::N_HOLDERS),
+            holder_of_node: self.get(vr::HOLDER_OF_NODE).iter().map(|&k| k as usize).collect(),
         }
     }
 
@@ -56,6 +73,7 @@ impl Params {
             cubature_tolerance: self.scalar(vr::CUBATURE_TOLERANCE),
             max_internal_step: self.scalar(vr::MAX_INTERNAL_STEP),
             substepping: true,
+            constraint_modes: true,
             training: TrainingProgram { scale: self.scalar(vr::TRAINING_SCALE), tilt: self.scalar(vr::TRAINING_TILT), time: self.scalar(vr::TRAINING_TIME) },
         }
     }
@@ -76,6 +94,10 @@ impl Params {
         loads.load_node = self.load_node();
         loads.anchor = [self.scalar(vr::ANCHOR_X), self.scalar(vr::ANCHOR_Y), self.scalar(vr::ANCHOR_Z)];
         loads.rotation = [self.scalar(vr::ANCHOR_R_X), self.scalar(vr::ANCHOR_R_Y), self.scalar(vr::ANCHOR_R_Z)];
+        for (pose, vrs) in loads.holders.iter_mut().zip(&HOLDER_INPUTS) {
+            pose.anchor = std::array::from_fn(|i| self.scalar(vrs[i]));
+            pose.rotation = std::array::from_fn(|i| self.scalar(vrs[3 + i]));
+        }
         loads.damping_alpha = self.scalar(vr::DAMPING_ALPHA);
         loads.damping_beta = self.scalar(vr::DAMPING_BETA);
         loads.mode_weights.clear();
@@ -85,9 +107,10 @@ impl Params {
     /// The load node (loadRow counted from the bottom edge, loadColumn
     /// from x = 0) as a node index in output order, if it is in the grid.
     pub fn load_node(&self) -> Option<usize> {
-        let grid = self.grid();
+        // Without building the grid: a Set in Step Mode allocates nothing.
+        let (columns, rows) = (self.count(vr::NX), self.count(vr::NY));
         let (row, col) = (self.count(vr::LOAD_ROW), self.count(vr::LOAD_COLUMN));
-        (row < grid.rows).then(|| grid.node(grid.rows - 1 - row, col)).flatten()
+        (row < rows && col < columns).then(|| (rows - 1 - row) * columns + col)
     }
 
     /// Why the load node (loadRow, loadColumn) cannot carry the point load

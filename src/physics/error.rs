@@ -52,6 +52,10 @@ pub enum Quantity {
     TrainingTilt,
     /// Length of each training run of a trained basis [s].
     TrainingTime,
+    /// Number of holders.
+    Holders,
+    /// A holder's displacement or rotation (holders 2 and on).
+    HolderMotion,
 }
 
 impl Quantity {
@@ -79,6 +83,8 @@ impl Quantity {
             Quantity::TrainingScale => "training range of gravity's magnitude",
             Quantity::TrainingTilt => "training range of gravity's tilt",
             Quantity::TrainingTime => "length of a training run",
+            Quantity::Holders => "number of holders",
+            Quantity::HolderMotion => "holder displacement or rotation",
         }
     }
 }
@@ -152,6 +158,12 @@ pub enum StepFailure {
     /// relative to the holder by more than half the spacing in one internal step of `dt`.
     #[error("the holder's angular velocity changes by {rate:e} rad/s at the start of the step: the sheet, reaching {reach:e} m from the pivot, would move relative to the holder by more than half the spacing per internal step of {dt:e} s (limit {limit:e} rad/s); turn the holder more smoothly")]
     TurnTooFast { rate: f64, limit: f64, reach: f64, dt: f64 },
+    /// Holder `holder` (2 or more) changes its velocity by `speed` at the
+    /// start of the step, its far node `reach` from its pivot included: the
+    /// sheet next to it would move relative to it by more than half the
+    /// spacing in one internal step of `dt`.
+    #[error("holder {holder}'s velocity changes by {speed:e} m/s at the start of the step: the sheet next to it would move relative to it by more than half the spacing per internal step of {dt:e} s (limit {limit:e} m/s); move the holder more smoothly")]
+    HolderTooFast { holder: usize, speed: f64, limit: f64, dt: f64 },
     /// The explicit velocity update of a full-space step under a turning
     /// holder with stiffness-proportional damping did not converge (the
     /// holder turns by more than a radian per internal step).
@@ -266,12 +278,41 @@ pub enum PhysicsError {
     /// the Coriolis force of a turning holder.
     #[error("the {} scheme integrates forces of the positions alone; a turning holder adds the Coriolis force, which depends on the rates", .scheme.name())]
     SchemeCannotTurn { scheme: Integrator },
+    /// The held nodes cannot be split among the holders as asked.
+    #[error("{0}")]
+    Holders(HolderProblem),
     /// A snapshot whose arrays do not fit this simulator.
     #[error("the snapshot holds {len} state values, this simulator needs {expected}")]
     SnapshotLength { len: usize, expected: usize },
     /// A snapshot holding NaN or infinite values.
     #[error("the snapshot holds non-finite values")]
     SnapshotNotFinite,
+}
+
+/// Why the held nodes cannot be given to the holders (holders counted from 1).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum HolderProblem {
+    /// A custom pattern with a length other than the grid's nodes.
+    #[error("the pattern of held nodes has {len} values, the grid has {expected} nodes")]
+    PatternLength { len: usize, expected: usize },
+    /// A node given to a holder beyond the number of holders.
+    #[error("node (row {row}, column {col}) is given to holder {id}, and there are {holders} holders")]
+    IdTooLarge { row: usize, col: usize, id: usize, holders: usize },
+    /// A holder that holds no node.
+    #[error("holder {holder} holds no node")]
+    NoNode { holder: usize },
+    /// A pattern that holds no node at all.
+    #[error("the pattern holds no node: the sheet would fall")]
+    NoHeldNode,
+    /// More holders than held columns to split among them.
+    #[error("{holders} holders cannot split the {columns} held columns among them (each needs a column)")]
+    TooFewColumns { holders: usize, columns: usize },
+    /// A holder that does not exist moved or turned.
+    #[error("holder {holder} does not exist (there are {holders}); its displacement and rotation must stay 0")]
+    Absent { holder: usize, holders: usize },
+    /// Several holders with a force model that leaves out springs.
+    #[error("the cubature's springs were chosen for one holder; several holders need exact forces")]
+    Cubature,
 }
 
 impl PhysicsError {

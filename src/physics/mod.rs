@@ -18,12 +18,12 @@ pub mod run;
 pub mod settings;
 pub mod setup;
 
-pub use error::{PhysicsError, Quantity, StepFailure};
+pub use error::{HolderProblem, PhysicsError, Quantity, StepFailure};
 pub use run::integrator::EXPLICIT_SAFETY;
 pub use run::simulator::{internal_step_count, Reads, SetUp, Sheet, Simulator, Steps, MAX_INTERNAL_STEPS_PER_CALL, STEP_COUNT_TOLERANCE};
-pub use run::state::{Loads, Snapshot, State};
+pub use run::state::{Loads, Motion, Pose, Snapshot, State, OTHER_HOLDERS};
 pub use settings::{ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction, Settings, TrainingProgram};
 pub use setup::grid::{FixedNodes, Grid};
 pub use setup::mode_classes::ModeClasses;
-pub use setup::scene::Scene;
+pub use setup::scene::{Holder, Scene, MAX_HOLDERS};
 pub use setup::setup_data::{SetupData, SpringSet, TrainedRange};

@@ -49,6 +49,10 @@ pub struct Settings {
     pub substepping: bool,
     /// With [`ModeSelection::Trained`]: the loads its training program runs.
     pub training: TrainingProgram,
+    /// With several holders and `anchor_motion` or `anchor_rotation`: the
+    /// constraint modes of the holders join the basis (`docs/method.md`,
+    /// section 9). Only tests and the study switch this off, to measure what they bring.
+    pub constraint_modes: bool,
 }
 
 /// The range a trained basis is trained for (`docs/method.md`, section 3;
@@ -94,6 +98,7 @@ impl Settings {
             max_internal_step: start::MAX_INTERNAL_STEP,
             substepping: true,
             training: TrainingProgram::default(),
+            constraint_modes: true,
         }
     }
 }

@@ -7,6 +7,7 @@
 //! - [`integrator`]: the schemes (explicit and implicit Newmark,
 //!   trigonometric), written once against [`space::Space`];
 //! - [`frame`]: the holder's frame and the mass moments of the sheet in it;
+//! - [`holders`]: holders that move on their own, their slots and their reactions;
 //! - [`state`]: [`state::State`] and [`state::Loads`], what changes while running;
 //! - [`simulator`]: a space and a scheme bound together in a run (generic),
 //!   the registry that chooses them, sub-stepping, divergence checks,
@@ -17,6 +18,7 @@
 
 pub mod forces;
 pub mod frame;
+pub mod holders;
 pub mod integrator;
 pub mod simulator;
 pub mod space;

@@ -9,8 +9,47 @@
 //!   simulator's backup before a step and the FMU state are snapshots.
 
 use crate::options::start;
-use crate::physics::error::{non_negative, PhysicsError, Quantity};
-use crate::physics::setup::scene::Scene;
+use crate::physics::error::{non_negative, Expected, HolderProblem, PhysicsError, Quantity};
+use crate::physics::setup::scene::{Scene, MAX_HOLDERS};
+
+/// Holders that move on their own, beside the first (whose frame the
+/// sheet is integrated in): holders 2 to [`MAX_HOLDERS`].
+pub const OTHER_HOLDERS: usize = MAX_HOLDERS - 1;
+
+/// Where a holder is to be: its displacement from its rest place and its
+/// rotation vector about its pivot from its rest orientation (z alone in 2D).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Pose {
+    /// [m]; z is ignored in 2D.
+    pub anchor: [f64; 3],
+    /// [rad]; x and y are ignored in 2D.
+    pub rotation: [f64; 3],
+}
+
+/// Where a holder is at a state's time and how it moved over the last
+/// communication step (first-order hold: constant velocity and spin).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Motion {
+    /// Displacement from its rest place [m].
+    pub anchor: [f64; 3],
+    /// Velocity over the last communication step [m/s].
+    pub anchor_rate: [f64; 3],
+    /// Rotation vector from its rest orientation [rad].
+    pub rotation: [f64; 3],
+    /// Angular velocity in its own axes over the last communication step [rad/s].
+    pub spin: [f64; 3],
+}
+
+impl Motion {
+    fn values(&self) -> impl Iterator<Item = &f64> {
+        self.anchor.iter().chain(&self.anchor_rate).chain(&self.rotation).chain(&self.spin)
+    }
+
+    /// It has left its rest place or moves.
+    pub fn moved(&self) -> bool {
+        self.values().any(|&x| x != 0.0)
+    }
+}
 
 /// Largest component of the holder's rotation vector [rad]: 1e6 rad is
 /// 160 000 turns, and keeps the angle's round-off below 1e-10 rad.
@@ -42,12 +81,25 @@ pub struct State {
     /// The holder's angular velocity in its own axes over the last
     /// communication step [rad/s].
     pub spin: [f64; 3],
+    /// Holders 2 and on: where they are at `time` and how they moved
+    /// (`docs/method.md`, section 9); at rest beyond the scene's holders.
+    pub holders: [Motion; OTHER_HOLDERS],
 }
 
 impl State {
     /// At rest at the linearization point, at time 0, with `n` coordinates.
     pub fn at_rest(n: usize) -> Self {
-        State { time: 0.0, y: vec![0.0; n], v: vec![0.0; n], a: vec![0.0; n], anchor: [0.0; 3], anchor_rate: [0.0; 3], rotation: [0.0; 3], spin: [0.0; 3] }
+        State {
+            time: 0.0,
+            y: vec![0.0; n],
+            v: vec![0.0; n],
+            a: vec![0.0; n],
+            anchor: [0.0; 3],
+            anchor_rate: [0.0; 3],
+            rotation: [0.0; 3],
+            spin: [0.0; 3],
+            holders: [Motion::default(); OTHER_HOLDERS],
+        }
     }
 
     /// Number of generalized coordinates.
@@ -69,6 +121,7 @@ impl State {
         self.anchor_rate = other.anchor_rate;
         self.rotation = other.rotation;
         self.spin = other.spin;
+        self.holders = other.holders;
     }
 
     /// Every value is a finite number.
@@ -83,6 +136,7 @@ impl State {
                 .chain(&self.anchor_rate)
                 .chain(&self.rotation)
                 .chain(&self.spin)
+                .chain(self.holders.iter().flat_map(Motion::values))
                 .all(|x| x.is_finite())
     }
 }
@@ -110,6 +164,11 @@ pub struct Loads {
     /// ignored in 2D. Over the step the holder turns at a constant rate
     /// from where it is ([`State::rotation`]) to here (`docs/method.md`, section 8).
     pub rotation: [f64; 3],
+    /// Where holders 2 and on are to be at the end of the next
+    /// communication step; over the step each moves linearly and turns at
+    /// a constant rate from where it is ([`State::holders`]). Only rest is
+    /// accepted beyond the scene's holders.
+    pub holders: [Pose; OTHER_HOLDERS],
     /// Rayleigh mass-proportional damping alpha [1/s].
     pub damping_alpha: f64,
     /// Rayleigh stiffness-proportional damping beta [s].
@@ -142,6 +201,7 @@ impl Loads {
             load_node: None,
             anchor: [start::ANCHOR_X, start::ANCHOR_Y, start::ANCHOR_Z],
             rotation: [start::ANCHOR_R_X, start::ANCHOR_R_Y, start::ANCHOR_R_Z],
+            holders: [Pose::default(); OTHER_HOLDERS],
             damping_alpha: start::DAMPING_ALPHA,
             damping_beta: start::DAMPING_BETA,
             mode_weights: vec![1.0; n_modes],
@@ -174,9 +234,7 @@ impl Loads {
         Some((self.load_dof(scene)?, f.iter().any(|&x| x != 0.0).then_some(f)?))
     }
 
-    /// Refuses loads that do not fit `scene`: a non-zero point load on a
-    /// node that is held or not in the scene.
-    /// The same loads apart from the anchor's and the holder's targets.
+    /// The same loads apart from the holders' targets.
     pub fn same_but_anchor(&self, other: &Loads) -> bool {
         self.gravity == other.gravity
             && self.point_load == other.point_load
@@ -186,7 +244,13 @@ impl Loads {
             && self.mode_weights == other.mode_weights
     }
 
+    /// Refuses loads that do not fit `scene`: a holder it does not have
+    /// moved, a non-zero point load on a node that is held or not in the scene.
     pub fn validate_on(&self, scene: &Scene) -> Result<(), PhysicsError> {
+        let holders = scene.holders.len().max(1);
+        if let Some(j) = self.holders.iter().enumerate().skip(holders - 1).position(|(_, p)| *p != Pose::default()) {
+            return Err(PhysicsError::Holders(HolderProblem::Absent { holder: holders + 1 + j, holders }));
+        }
         if self.active_point_load(scene.dim).is_some() && self.load_dof(scene).is_none() {
             let held = self.load_node.is_some_and(|n| n < scene.n_nodes);
             return Err(PhysicsError::LoadNode { node: self.load_node, held });
@@ -203,16 +267,24 @@ impl Loads {
     /// Refuses loads the solver cannot use, for `n_modes` modes.
     pub fn validate(&self, n_modes: usize) -> Result<(), PhysicsError> {
         if let Some(&g) = self.gravity.iter().find(|g| !g.is_finite()) {
-            return Err(PhysicsError::Invalid { quantity: Quantity::Gravity, value: g, expected: crate::physics::error::Expected::Finite });
+            return Err(PhysicsError::Invalid { quantity: Quantity::Gravity, value: g, expected: Expected::Finite });
         }
         if let Some(&f) = self.point_load.iter().find(|f| !f.is_finite()) {
-            return Err(PhysicsError::Invalid { quantity: Quantity::PointLoad, value: f, expected: crate::physics::error::Expected::Finite });
+            return Err(PhysicsError::Invalid { quantity: Quantity::PointLoad, value: f, expected: Expected::Finite });
         }
         if let Some(&a) = self.anchor.iter().find(|a| !a.is_finite()) {
-            return Err(PhysicsError::Invalid { quantity: Quantity::Anchor, value: a, expected: crate::physics::error::Expected::Finite });
+            return Err(PhysicsError::Invalid { quantity: Quantity::Anchor, value: a, expected: Expected::Finite });
         }
         if let Some(&a) = self.rotation.iter().find(|a| !(a.abs() <= MAX_ROTATION)) {
-            return Err(PhysicsError::Invalid { quantity: Quantity::Rotation, value: a, expected: crate::physics::error::Expected::Within(MAX_ROTATION) });
+            return Err(PhysicsError::Invalid { quantity: Quantity::Rotation, value: a, expected: Expected::Within(MAX_ROTATION) });
+        }
+        for p in &self.holders {
+            if let Some(&a) = p.anchor.iter().find(|a| !a.is_finite()) {
+                return Err(PhysicsError::Invalid { quantity: Quantity::HolderMotion, value: a, expected: Expected::Finite });
+            }
+            if let Some(&a) = p.rotation.iter().find(|a| !(a.abs() <= MAX_ROTATION)) {
+                return Err(PhysicsError::Invalid { quantity: Quantity::HolderMotion, value: a, expected: Expected::Within(MAX_ROTATION) });
+            }
         }
         non_negative(Quantity::DampingAlpha, self.damping_alpha)?;
         non_negative(Quantity::DampingBeta, self.damping_beta)?;

@@ -156,6 +156,101 @@ pub fn static_vectors(
     Ok(vectors)
 }
 
+/// The constraint modes of the holders that move on their own
+/// (Craig–Bampton; `docs/method.md`, section 9): for each such holder and
+/// each unit motion of its slots it may make, the static displacement of
+/// the free DOFs, u = K_ff⁻¹ K_fh b, through the stiffness K(x*) at the
+/// linearization point. The unit motions span every rigid placement of
+/// the holder exactly, however far it turns: a translation e_i
+/// (`anchor_motion`), and e_i ((X - P)_j) for every pair of axes i, j
+/// (`anchor_rotation`: R - I has d² entries), those that move a slot.
+/// Empty with one holder, or when the holders will not move.
+pub fn constraint_vectors(
+    scene: &Scene,
+    pattern: &StiffnessPattern,
+    stiffness: &[f64],
+    point: &[f64],
+    settings: &Settings,
+) -> Result<Vec<Vec<f64>>, PhysicsError> {
+    let holders = scene.moving_holders();
+    if holders.is_empty() || !settings.constraint_modes || !(settings.anchor_motion || settings.anchor_rotation) {
+        return Ok(Vec::new());
+    }
+    let (d, n_free) = (scene.dim, scene.n_free);
+    let mut vectors = Vec::new();
+    let solver = ShiftedStiffness::new(scene, pattern, stiffness)?;
+    for h in holders {
+        let mut held = vec![false; scene.rest.len() / d];
+        h.slots.iter().for_each(|&s| held[s] = true);
+        // Unit motions: (axis i moved, lever axis j or none for a translation).
+        let mut motions: Vec<(usize, Option<usize>)> = Vec::new();
+        if settings.anchor_motion {
+            motions.extend((0..d).map(|i| (i, None)));
+        }
+        if settings.anchor_rotation {
+            motions.extend((0..d).flat_map(|i| (0..d).map(move |j| (i, Some(j)))));
+        }
+        for (i, lever) in motions {
+            let shift = |slot: usize| -> f64 { lever.map_or(1.0, |j| scene.rest[slot * d + j] - h.pivot[j]) };
+            let mut f = vec![0.0; scene.n_dofs()];
+            for s in &scene.springs {
+                let (free, other) = match (s.a < n_free, s.b < n_free) {
+                    (true, false) => (s.a, s.b),
+                    (false, true) => (s.b, s.a),
+                    _ => continue,
+                };
+                if !held[other] || shift(other) == 0.0 {
+                    continue;
+                }
+                // The pull on the free end when the held end moves by b: K_e b.
+                let b = shift(other);
+                let dvec: Vec<f64> = (0..d).map(|c| point[s.b * d + c] - point[s.a * d + c]).collect();
+                for (r, fr) in f[free * d..(free + 1) * d].iter_mut().enumerate() {
+                    *fr += b * tangent_entry(&dvec, s.k, s.rest, r, i);
+                }
+            }
+            if f.iter().any(|&x| x != 0.0) {
+                vectors.push(solver.solve(&f));
+            }
+        }
+    }
+    Ok(vectors)
+}
+
+/// The linear static response of the free DOFs at rest to the held slots
+/// placed at `x` (every slot's position; the free ones are not read):
+/// u = K_ff⁻¹ K_fh (x_h - X_h), K the stiffness at rest. Where a run
+/// starts when a holder is set away from its rest place before it starts.
+pub fn static_response(scene: &Scene, x: &[f64]) -> Result<Vec<f64>, PhysicsError> {
+    let (d, n_free) = (scene.dim, scene.n_free);
+    let (pattern, stiffness) = crate::physics::run::forces::linearize(scene);
+    let mut f = vec![0.0; scene.n_dofs()];
+    for s in &scene.springs {
+        let (free, other) = match (s.a < n_free, s.b < n_free) {
+            (true, false) => (s.a, s.b),
+            (false, true) => (s.b, s.a),
+            _ => continue,
+        };
+        let moved: Vec<f64> = (0..d).map(|c| x[other * d + c] - scene.rest[other * d + c]).collect();
+        if moved.iter().all(|&m| m == 0.0) {
+            continue;
+        }
+        let dvec: Vec<f64> = (0..d).map(|c| scene.rest[s.b * d + c] - scene.rest[s.a * d + c]).collect();
+        for (r, fr) in f[free * d..(free + 1) * d].iter_mut().enumerate() {
+            *fr += (0..d).map(|c| tangent_entry(&dvec, s.k, s.rest, r, c) * moved[c]).sum::<f64>();
+        }
+    }
+    Ok(ShiftedStiffness::new(scene, &pattern, &stiffness)?.solve(&f))
+}
+
+/// Entry (r, c) of a spring's tangent block k [u uᵀ + (1 - l0/l)(I - u uᵀ)], u = d / l.
+fn tangent_entry(d: &[f64], k: f64, l0: f64, r: usize, c: usize) -> f64 {
+    let l = d.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let uu = d[r] * d[c] / (l * l);
+    let id = if r == c { 1.0 } else { 0.0 };
+    k * (uu + (1.0 - l0 / l) * (id - uu))
+}
+
 /// The basis of `n_modes` vectors on `scene` under `loads`, chosen and
 /// linearized as `settings` ask (`mode_selection`, `static_correction`,
 /// `linearization`, `anchor_motion`). A trained basis comes from its
@@ -178,15 +273,18 @@ pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) 
     if needs_load && patterns.is_empty() {
         return Err(PhysicsError::NoLoad);
     }
-    let plain = selection == ModeSelection::Lowest && !settings.static_correction;
+    let constraints = constraint_vectors(scene, &pattern, &stiffness, &point, settings)?;
+    let plain = selection == ModeSelection::Lowest && !settings.static_correction && constraints.is_empty();
     let modes = if plain {
         ModalBasis::lowest(scene, &pattern, &stiffness, n_modes)?
     } else {
-        let statics = if settings.static_correction { patterns.len().min(n_modes) } else { 0 };
+        let static_list = if settings.static_correction { static_vectors(scene, &pattern, &stiffness, &point, &patterns, settings)? } else { Vec::new() };
+        // Every static vector and constraint mode has its place (at the equilibrium there is one more static vector than load patterns: the sag).
+        let statics = (static_list.len() + constraints.len()).min(n_modes);
         let eigen = n_modes - statics;
         // Candidates in the order they are wanted; a few more than needed
         // stand in for static responses the modes already hold.
-        let spare = if settings.static_correction { statics } else { 0 };
+        let spare = statics;
         let candidates = match selection {
             ModeSelection::Load => {
                 // Away from rest the run starts displaced from x* by x_rest - x*: its modal amplitudes count too.
@@ -197,10 +295,9 @@ pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) 
         };
         let columns = |b: &ModalBasis, j: usize| -> Vec<f64> { (0..n).map(|i| b.phi[i * b.r + j]).collect() };
         let mut vectors: Vec<Vec<f64>> = (0..eigen.min(candidates.r)).map(|j| columns(&candidates, j)).collect();
-        if settings.static_correction {
-            vectors.extend(static_vectors(scene, &pattern, &stiffness, &point, &patterns, settings)?);
-            vectors.extend((eigen..candidates.r).map(|j| columns(&candidates, j)));
-        }
+        vectors.extend(static_list);
+        vectors.extend(constraints);
+        vectors.extend((eigen..candidates.r).map(|j| columns(&candidates, j)));
         orthonormal_ritz(scene, &pattern, &stiffness, &vectors, n_modes)?
     };
     Ok(Basis { point, at_rest, pattern, stiffness, modes })

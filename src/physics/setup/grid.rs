@@ -5,8 +5,8 @@
 //! ever sees the scene.
 
 pub use crate::options::FixedNodes;
-use crate::physics::error::{non_negative, positive, Expected, PhysicsError, Quantity};
-use crate::physics::setup::scene::{Scene, Spring};
+use crate::physics::error::{non_negative, positive, Expected, HolderProblem, PhysicsError, Quantity};
+use crate::physics::setup::scene::{Holder, Scene, Spring, MAX_HOLDERS};
 
 /// Largest grid accepted (nodes); beyond it the arrays alone pass a gigabyte.
 pub const MAX_NODES: usize = 4_000_000;
@@ -36,6 +36,11 @@ pub struct Grid {
     pub aux_stiffness: f64,
     /// Which nodes are held in place.
     pub fixed_nodes: FixedNodes,
+    /// Holders the held nodes are split among (1 to [`MAX_HOLDERS`]).
+    pub holders: usize,
+    /// With [`FixedNodes::Custom`]: per node (row-major) its holder, 1 to
+    /// `holders`, or 0 for a free node.
+    pub holder_of_node: Vec<usize>,
 }
 
 impl Grid {
@@ -44,7 +49,8 @@ impl Grid {
         self.validate()?;
         let (cols, rows, d, h) = (self.columns, self.rows, self.dim, self.spacing);
         let n_nodes = cols * rows;
-        let is_fixed = |node: usize| self.is_held(node);
+        let holder_of: Vec<Option<usize>> = (0..n_nodes).map(|node| self.holder_of(node)).collect();
+        let is_fixed = |node: usize| holder_of[node].is_some();
         // Free nodes first, in node order, then fixed nodes.
         let mut slot_of_node = vec![0; n_nodes];
         let mut next = 0;
@@ -67,9 +73,10 @@ impl Grid {
         }
         let mut springs = Vec::new();
         let mut join = |r0: usize, c0: usize, r1: usize, c1: usize| {
-            let (a, b) = (slot_of_node[r0 * cols + c0], slot_of_node[r1 * cols + c1]);
-            if a >= n_free && b >= n_free {
-                return; // both ends fixed: it never moves, never acts
+            let (n0, n1) = (r0 * cols + c0, r1 * cols + c1);
+            let (a, b) = (slot_of_node[n0], slot_of_node[n1]);
+            if a >= n_free && b >= n_free && holder_of[n0] == holder_of[n1] {
+                return; // both ends on one holder: it never moves, never acts
             }
             let len = (0..d).map(|i| (rest[b * d + i] - rest[a * d + i]).powi(2)).sum::<f64>().sqrt();
             springs.push(Spring { a, b, k: self.spring_stiffness, rest: len });
@@ -107,7 +114,17 @@ impl Grid {
                 springs.push(Spring { a: s, b: anchor, k: self.aux_stiffness, rest: h });
             }
         }
-        let scene = Scene { dim: d, n_nodes, n_free, slot_of_node, rest, dof_mass: vec![self.node_mass; n_free * d], springs };
+        let mut holders: Vec<Holder> = (0..self.holders).map(|_| Holder { slots: Vec::new(), pivot: [0.0; 3] }).collect();
+        for (node, h) in holder_of.iter().enumerate() {
+            if let Some(h) = *h {
+                let slot = slot_of_node[node];
+                if holders[h].slots.is_empty() {
+                    holders[h].pivot = std::array::from_fn(|i| if i < d { rest[slot * d + i] } else { 0.0 });
+                }
+                holders[h].slots.push(slot);
+            }
+        }
+        let scene = Scene { dim: d, n_nodes, n_free, slot_of_node, rest, dof_mass: vec![self.node_mass; n_free * d], springs, holders };
         scene.check()?;
         Ok(scene)
     }
@@ -119,12 +136,59 @@ impl Grid {
 
     /// Node `node` is held in place.
     pub fn is_held(&self, node: usize) -> bool {
+        self.holder_of(node).is_some()
+    }
+
+    /// The holder of node `node` (counted from 0), if it is held: the
+    /// custom pattern's, or with the top row or corners the held columns
+    /// split among the holders left to right (holder k takes the held
+    /// columns j, counted from the left among the m held ones, with
+    /// floor(j holders / m) = k).
+    pub fn holder_of(&self, node: usize) -> Option<usize> {
         let (row, col) = (node / self.columns, node % self.columns);
-        row == 0
-            && match self.fixed_nodes {
-                FixedNodes::TopRow => true,
-                FixedNodes::TopCorners => col == 0 || col == self.columns - 1,
+        let n = self.holders.max(1);
+        match self.fixed_nodes {
+            FixedNodes::Custom => self.holder_of_node.get(node).copied().filter(|&k| k > 0).map(|k| k - 1),
+            FixedNodes::TopRow => (row == 0).then(|| col * n / self.columns),
+            FixedNodes::TopCorners => {
+                let m = if self.columns > 1 { 2 } else { 1 };
+                (row == 0 && (col == 0 || col == self.columns - 1)).then(|| if col == 0 { 0 } else { (m - 1) * n / m })
             }
+        }
+    }
+
+    /// Refuses a split of the held nodes that leaves a holder without a
+    /// node, names a holder that does not exist, or holds nothing.
+    fn validate_holders(&self) -> Result<(), PhysicsError> {
+        let n = self.holders;
+        if !(1..=MAX_HOLDERS).contains(&n) {
+            return Err(PhysicsError::Invalid { quantity: Quantity::Holders, value: n as f64, expected: Expected::Within(MAX_HOLDERS as f64) });
+        }
+        let nodes = self.columns * self.rows;
+        match self.fixed_nodes {
+            FixedNodes::Custom => {
+                if self.holder_of_node.len() != nodes {
+                    return Err(PhysicsError::Holders(HolderProblem::PatternLength { len: self.holder_of_node.len(), expected: nodes }));
+                }
+                if let Some(node) = self.holder_of_node.iter().position(|&k| k > n) {
+                    let (row, col, id) = (node / self.columns, node % self.columns, self.holder_of_node[node]);
+                    return Err(PhysicsError::Holders(HolderProblem::IdTooLarge { row, col, id, holders: n }));
+                }
+                if self.holder_of_node.iter().all(|&k| k == 0) {
+                    return Err(PhysicsError::Holders(HolderProblem::NoHeldNode));
+                }
+                if let Some(holder) = (1..=n).find(|k| !self.holder_of_node.contains(k)) {
+                    return Err(PhysicsError::Holders(HolderProblem::NoNode { holder }));
+                }
+            }
+            FixedNodes::TopRow | FixedNodes::TopCorners => {
+                let columns = if self.fixed_nodes == FixedNodes::TopRow || self.columns == 1 { self.columns } else { 2 };
+                if n > columns {
+                    return Err(PhysicsError::Holders(HolderProblem::TooFewColumns { holders: n, columns }));
+                }
+            }
+        }
+        Ok(())
     }
 
     fn validate(&self) -> Result<(), PhysicsError> {
@@ -140,6 +204,7 @@ impl Grid {
             Some(n) if n <= MAX_NODES => {}
             _ => return Err(PhysicsError::TooManyNodes { nodes: self.columns as f64 * self.rows as f64, limit: MAX_NODES }),
         }
+        self.validate_holders()?;
         positive(Quantity::Spacing, self.spacing)?;
         positive(Quantity::NodeMass, self.node_mass)?;
         positive(Quantity::SpringStiffness, self.spring_stiffness)?;
@@ -162,6 +227,8 @@ pub(crate) fn paper(columns: usize, rows: usize, dim: usize, fixed_nodes: FixedN
         bending_springs: false,
         aux_stiffness: if dim == 3 { 0.05 } else { 0.0 },
         fixed_nodes,
+        holders: 1,
+        holder_of_node: Vec::new(),
     }
 }
 

@@ -11,6 +11,23 @@
 
 use crate::physics::error::{Expected, PhysicsError, Quantity};
 
+/// Most holders a scene may have.
+pub const MAX_HOLDERS: usize = 4;
+
+/// A holder: the held slots it moves together, and its pivot.
+///
+/// The sheet is integrated in the frame of the first holder (holder 1 of
+/// the model description), which carries every held slot it does not list
+/// too (the auxiliary springs' points). Every other holder places its slots
+/// in that frame as it moves (`docs/method.md`, section 9).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Holder {
+    /// Its held slots, in node order (row-major).
+    pub slots: Vec<usize>,
+    /// The rest position of its first node, about which it turns (z 0 in 2D) [m].
+    pub pivot: [f64; 3],
+}
+
 /// One spring between two slots: stiffness `k`, rest length `rest`.
 #[derive(Clone, Copy, Debug)]
 pub struct Spring {
@@ -36,6 +53,10 @@ pub struct Scene {
     /// Mass of each free DOF (the diagonal of M).
     pub dof_mass: Vec<f64>,
     pub springs: Vec<Spring>,
+    /// The holders, the first one's frame the frame of the equations; may
+    /// be empty (scenes not built from a grid), which is one holder of
+    /// every held slot with its pivot at node 0.
+    pub holders: Vec<Holder>,
 }
 
 impl Scene {
@@ -65,11 +86,20 @@ impl Scene {
         Ok(())
     }
 
-    /// The pivot X0: the rest position of node 0 (z 0 in 2D), about which
-    /// the holder turns and its torque is taken (`docs/method.md`, section 8).
+    /// The pivot X0 of the first holder, about which it turns and its
+    /// torque is taken (`docs/method.md`, section 8): the rest position of
+    /// its first node (node 0 for the grid's top row and top corners; z 0 in 2D).
     pub fn pivot(&self) -> [f64; 3] {
+        if let Some(h) = self.holders.first() {
+            return h.pivot;
+        }
         let (d, slot) = (self.dim, self.slot_of_node[0]);
         std::array::from_fn(|i| if i < d { self.rest[slot * d + i] } else { 0.0 })
+    }
+
+    /// Holders that move on their own: every holder but the first.
+    pub fn moving_holders(&self) -> &[Holder] {
+        self.holders.get(1..).unwrap_or(&[])
     }
 
     /// Total mass of the free nodes [kg].

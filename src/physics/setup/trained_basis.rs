@@ -32,6 +32,7 @@ use faer::Mat;
 
 use crate::physics::error::{Expected, PhysicsError, Quantity};
 use crate::physics::run::frame::{apply, cross, dot, norm, rotation, Frame};
+use crate::physics::run::holders::{self, Placement};
 use crate::physics::run::integrator::{Buffers, NewmarkExplicit, Scheme};
 use crate::physics::run::space::{basis_bound, Full, Space};
 use crate::physics::run::state::{Loads, State};
@@ -47,6 +48,8 @@ pub const SAMPLES: usize = 40;
 const ANCHOR_ACCELERATION: f64 = 0.5;
 /// The holder's training spin: centrifugal acceleration Ω² ℓ as a share of |g|.
 const SPIN_ACCELERATION: f64 = 0.3;
+/// How far the training moves each holder other than the first, as a share of ℓ.
+const HOLDER_SHIFT: f64 = 0.1;
 
 /// One run of the training program: the loads in the holder's frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -57,6 +60,9 @@ pub struct Case {
     pub point_load: [f64; 3],
     /// The spin the holder is jerked into at the start [rad/s].
     pub spin: [f64; 3],
+    /// A holder that moves on its own (counted among those) jerked away
+    /// from its place at the start and held there [m].
+    pub holder: Option<(usize, [f64; 3])>,
 }
 
 /// Refuses a training program that means nothing physically: gravity
@@ -92,7 +98,7 @@ pub fn program(scene: &Scene, loads: &Loads, settings: &Settings) -> Result<Vec<
     if g_norm == 0.0 && p == [0.0; 3] {
         return Err(PhysicsError::NoLoad);
     }
-    let case = |label: String, gravity: [f64; 3], point_load: [f64; 3], spin: [f64; 3]| Case { label, gravity, point_load, spin };
+    let case = |label: String, gravity: [f64; 3], point_load: [f64; 3], spin: [f64; 3]| Case { label, gravity, point_load, spin, holder: None };
     let scaled = |v: &[f64; 3], s: f64| -> [f64; 3] { std::array::from_fn(|i| s * v[i]) };
     let mut cases = vec![case("the set-up loads".into(), g, p, [0.0; 3])];
     if t.scale > 0.0 && g_norm > 0.0 {
@@ -130,6 +136,19 @@ pub fn program(scene: &Scene, loads: &Loads, settings: &Settings) -> Result<Vec<
         for &i in axes {
             let spin: [f64; 3] = std::array::from_fn(|k| if k == i { omega } else { 0.0 });
             cases.push(case(format!("holder jerked into a spin of {omega:.3} rad/s about {}", AXES[i]), g, p, spin));
+        }
+    }
+    if settings.anchor_motion {
+        // Every other holder pulled away from its place either way along each axis: the sheet stretched between them.
+        let shift = HOLDER_SHIFT * scene.length_scale();
+        for j in 0..scene.moving_holders().len() {
+            for i in 0..d {
+                for sign in [1.0, -1.0] {
+                    let moved: [f64; 3] = std::array::from_fn(|k| if k == i { sign * shift } else { 0.0 });
+                    let label = format!("holder {} moved {:+.3} m along {}", j + 2, sign * shift, AXES[i]);
+                    cases.push(Case { holder: Some((j, moved)), ..case(label, g, p, [0.0; 3]) });
+                }
+            }
         }
     }
     Ok(cases)
@@ -184,6 +203,10 @@ pub fn snapshots(scene: &Scene, loads: &Loads, settings: &Settings, point: &[f64
         let mut buf = Buffers::new(n, NewmarkExplicit::SCRATCH);
         let mut state = State::at_rest(n);
         space.apply_loads(&mut w);
+        if let Some((j, moved)) = case.holder {
+            let at: Vec<Placement> = (0..scene.moving_holders().len()).map(|k| Placement::new(if k == j { moved } else { [0.0; 3] }, &[0.0; 3])).collect();
+            holders::place(scene, &Placement::new([0.0; 3], &[0.0; 3]), &at, space.slots_mut(&mut w));
+        }
         if case.spin != [0.0; 3] {
             // In the holder's frame the sheet at rest gets -Ω x ρ at once.
             space.turn(&Frame { gravity: case.gravity, load: case.point_load, spin: case.spin }, &mut w);
@@ -241,7 +264,7 @@ pub fn train(scene: Scene, loads: &Loads, settings: &Settings) -> Result<SetupDa
     }
     let (point, pattern, stiffness) = basis::linearize(&scene, loads, settings)?;
     let columns = snapshots(&scene, loads, settings, &point)?;
-    let statics = if settings.static_correction {
+    let mut statics = if settings.static_correction {
         let patterns = load_patterns(&scene, loads, settings.anchor_motion, settings.anchor_rotation);
         if patterns.is_empty() {
             return Err(PhysicsError::NoLoad);
@@ -250,6 +273,7 @@ pub fn train(scene: Scene, loads: &Loads, settings: &Settings) -> Result<SetupDa
     } else {
         Vec::new()
     };
+    statics.extend(basis::constraint_vectors(&scene, &pattern, &stiffness, &point, settings)?);
     let p = statics.len().min(r);
     // A few more components than needed stand in for static responses the components already hold.
     let components = principal_components(&scene.dof_mass, &columns, r + p)?;

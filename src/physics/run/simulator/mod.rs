@@ -37,7 +37,7 @@ use crate::physics::run::integrator::{Buffers, NewmarkExplicit, NewmarkImplicit,
 use crate::physics::run::space::{Cubature, Exact, Full, Modal, Readout};
 use crate::physics::run::state::{Loads, State};
 use crate::physics::settings::{ForceEvaluation, Integrator, ModeSelection, Reduction, Settings};
-use crate::physics::setup::scene::Scene;
+use crate::physics::setup::scene::{Scene, MAX_HOLDERS};
 use crate::physics::setup::setup_data::SetupData;
 use crate::physics::setup::{cubature_training, trained_basis};
 
@@ -75,6 +75,8 @@ struct Fresh {
     /// The holder's force and torque.
     anchor: bool,
     torque: bool,
+    /// Each holder's force and torque.
+    holders: bool,
     velocities: bool,
     potential: bool,
     residual: bool,
@@ -120,6 +122,12 @@ pub struct Run<S: Readout, I: Scheme> {
     /// Gravity and the point load turned into the holder's frame at the
     /// state's orientation, while it has turned.
     local: FrameLoads,
+    /// Per holder that moves on its own: the springs that end on its slots
+    /// (for its reaction), and how far its slots reach from its pivot (for its speed limit).
+    holder_ends: Vec<Vec<(usize, bool)>>,
+    holder_arms: Vec<f64>,
+    /// (holder among those that move on their own, node) for every node they hold.
+    holder_nodes: Vec<(usize, usize)>,
     scheme: PhantomData<I>,
 }
 
@@ -154,6 +162,10 @@ pub struct Outputs {
     pub anchor_force: [f64; 3],
     /// The torque the sheet exerts on its holder about the pivot [N m].
     pub anchor_torque: [f64; 3],
+    /// Per holder, the force and the torque the sheet exerts on it (about
+    /// its pivot), holder 1's the momentum balance less the others' (`docs/method.md`, section 9).
+    pub holder_forces: [[f64; 3]; MAX_HOLDERS],
+    pub holder_torques: [[f64; 3]; MAX_HOLDERS],
 }
 
 impl Outputs {
@@ -170,6 +182,8 @@ impl Outputs {
             force_residual: 0.0,
             anchor_force: [0.0; 3],
             anchor_torque: [0.0; 3],
+            holder_forces: [[0.0; 3]; MAX_HOLDERS],
+            holder_torques: [[0.0; 3]; MAX_HOLDERS],
         }
     }
 }
@@ -197,6 +211,9 @@ impl Simulator {
         }
         loads.validate(settings.n_modes)?;
         loads.validate_on(&scene)?;
+        if scene.holders.len() > 1 && settings.reduction == Reduction::Modal && settings.force_evaluation == ForceEvaluation::Cubature {
+            return Err(PhysicsError::Holders(crate::physics::error::HolderProblem::Cubature));
+        }
         Ok(Simulator(build(scene, settings, loads, prebuilt)?))
     }
 

@@ -9,13 +9,15 @@
 
 use super::{to_node_order, Reads, Run, SetUp, Steps};
 use crate::physics::error::PhysicsError;
-use crate::physics::run::frame::{apply, cross, dot, ground_velocity, place, rotation};
+use crate::physics::run::frame::{apply, apply_transposed, cross, dot, ground_velocity, place, rotation};
+use crate::physics::run::holders::{self, Placement};
 use crate::physics::run::integrator::Scheme;
 use crate::physics::run::space::Readout;
 use crate::physics::run::state::Loads;
 use crate::physics::setup::mode_classes::{self, ModeClasses};
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
+use crate::physics::setup::scene::MAX_HOLDERS;
 use crate::physics::setup::setup_data::SetupData;
 
 impl<S: Readout, I: Scheme> Run<S, I> {
@@ -56,6 +58,46 @@ impl<S: Readout, I: Scheme> Run<S, I> {
         }
     }
 
+    /// Each holder's force and torque into the outputs (see [`Reads::holder_force`]):
+    /// for every holder k but the first, the springs' pull on its slots in
+    /// the first holder's frame about its pivot there, turned into the
+    /// ground's; the first holder's, the momentum balance less theirs, its
+    /// torque less their moments about its own pivot as well.
+    fn holder_reactions(&mut self) {
+        if self.fresh.holders {
+            return;
+        }
+        let (mut forces, mut torques) = ([[0.0; 3]; MAX_HOLDERS], [[0.0; 3]; MAX_HOLDERS]);
+        let (mut first_force, mut first_torque) = (self.anchor_force(), self.anchor_torque());
+        let (moving, d) = (self.space.scene().moving_holders().len(), self.space.scene().dim);
+        if moving > 0 {
+            self.forces_current();
+            let r1 = rotation(&self.state.rotation);
+            let p1: [f64; 3] = std::array::from_fn(|i| self.pivot[i] + self.state.anchor[i]);
+            for j in 0..moving {
+                let pivot = self.space.scene().moving_holders()[j].pivot;
+                let g: [f64; 3] = std::array::from_fn(|i| pivot[i] + self.state.holders[j].anchor[i]);
+                let local = apply_transposed(&r1, &std::array::from_fn(|i| g[i] - p1[i]));
+                let pivot_frame: [f64; 3] = std::array::from_fn(|i| self.pivot[i] + local[i]);
+                let (space, work, y) = (&self.space, &mut self.work, &self.state.y);
+                let (f, t) = holders::reaction(space.scene(), &self.holder_ends[j], &pivot_frame, |slot| space.slot_position(y, slot, work));
+                let (f, t) = (apply(&r1, &f), apply(&r1, &t));
+                let arm = cross(&std::array::from_fn(|i| g[i] - p1[i]), &f);
+                for i in 0..3 {
+                    first_force[i] -= f[i];
+                    first_torque[i] -= t[i] + arm[i];
+                }
+                forces[j + 1] = planar_vector(f, d, false);
+                torques[j + 1] = planar_vector(t, d, true);
+            }
+        }
+        forces[0] = planar_vector(first_force, d, false);
+        torques[0] = planar_vector(first_torque, d, true);
+        self.outputs.holder_forces = forces;
+        self.outputs.holder_torques = torques;
+        self.fresh.holders = true;
+    }
+
     /// Elastic energy of every spring at the state [J].
     fn elastic_energy_now(&mut self) -> f64 {
         self.forces_current();
@@ -90,6 +132,13 @@ impl<S: Readout, I: Scheme> Reads for Run<S, I> {
             } else {
                 shift(&mut self.outputs.positions, &self.state.anchor, self.space.scene().dim);
             }
+            // The nodes of the other holders where they put them, G = P + a + R (X - P).
+            let (scene, d) = (self.space.scene(), self.space.scene().dim);
+            for &(j, node) in &self.holder_nodes {
+                let (h, m, slot) = (&scene.moving_holders()[j], &self.state.holders[j], scene.slot_of_node[node]);
+                let g = place(&h.pivot, &m.anchor, &rotation(&m.rotation), &scene.rest[slot * d..(slot + 1) * d]);
+                self.outputs.positions[node * d..(node + 1) * d].copy_from_slice(&g[..d]);
+            }
             self.fresh.positions = true;
         }
         &self.outputs.positions
@@ -108,6 +157,12 @@ impl<S: Readout, I: Scheme> Reads for Run<S, I> {
                 }
             } else {
                 shift(&mut self.outputs.velocities, &self.state.anchor_rate, self.space.scene().dim);
+            }
+            let (scene, d) = (self.space.scene(), self.space.scene().dim);
+            for &(j, node) in &self.holder_nodes {
+                let (h, m, slot) = (&scene.moving_holders()[j], &self.state.holders[j], scene.slot_of_node[node]);
+                let v = holders::slot_velocity(h, m, &Placement::new(m.anchor, &m.rotation), &scene.rest[slot * d..(slot + 1) * d]);
+                self.outputs.velocities[node * d..(node + 1) * d].copy_from_slice(&v[..d]);
             }
             self.fresh.velocities = true;
         }
@@ -189,6 +244,16 @@ impl<S: Readout, I: Scheme> Reads for Run<S, I> {
             self.fresh.torque = true;
         }
         self.outputs.anchor_torque
+    }
+
+    fn holder_force(&mut self, k: usize) -> [f64; 3] {
+        self.holder_reactions();
+        self.outputs.holder_forces.get(k).copied().unwrap_or_default()
+    }
+
+    fn holder_torque(&mut self, k: usize) -> [f64; 3] {
+        self.holder_reactions();
+        self.outputs.holder_torques.get(k).copied().unwrap_or_default()
     }
 
     fn kinetic_energy(&self) -> f64 {
@@ -274,6 +339,15 @@ impl<S: Readout, I: Scheme> SetUp for Run<S, I> {
 
     fn cubature_springs(&self) -> usize {
         self.space.layout().springs
+    }
+}
+
+/// A force (`torque` false: no z in 2D) or a torque (only z in 2D) as the scene's dimension `d` has it.
+fn planar_vector(v: [f64; 3], d: usize, torque: bool) -> [f64; 3] {
+    match (d, torque) {
+        (3, _) => v,
+        (_, false) => [v[0], v[1], 0.0],
+        (_, true) => [0.0, 0.0, v[2]],
     }
 }
 

@@ -83,6 +83,16 @@ pub trait Reads {
     /// S x g + rho_p x f_p - sum m rho x y'', less, while the holder turns at w,
     /// 2 (w tr N - N w) - w x (J w); only z in 2D. O(r^2) in the modal space [N m].
     fn anchor_torque(&mut self) -> [f64; 3];
+    /// The force the sheet exerts on holder `k` (counted from 0; 0 beyond
+    /// the scene's holders): for every holder but the first, the forces of
+    /// the springs that end on its slots; for the first, [`Self::anchor_force`]
+    /// less the others', so that they add up to it (`docs/method.md`, section 9).
+    /// O(springs on the holders x r) in the modal space; z is 0 in 2D [N].
+    fn holder_force(&mut self, k: usize) -> [f64; 3];
+    /// The torque the sheet exerts on holder `k` about its pivot (the rest
+    /// position of its first node, carried by its displacement), the same
+    /// way; only z in 2D [N m].
+    fn holder_torque(&mut self, k: usize) -> [f64; 3];
     /// 1/2 v^T M v [J].
     fn kinetic_energy(&self) -> f64;
     /// Elastic energy of the springs plus gravitational energy relative to

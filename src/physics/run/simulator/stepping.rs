@@ -7,9 +7,10 @@ use super::{internal_step_count, turn_loads, FrameLoads, Fresh, Outputs, Run, St
 use super::{ENERGY_GROWTH_LIMIT, MAX_INTERNAL_STEPS_PER_CALL, MAX_STABLE_SUBSTEPS};
 use crate::physics::error::{positive, PhysicsError, Quantity, StepFailure};
 use crate::physics::run::frame::{self, apply, apply_transposed, compose, cross, dot, into_frame, norm, planar, rotation, Frame, Moments};
+use crate::physics::run::holders::{self, Placement};
 use crate::physics::run::integrator::{Buffers, Scheme};
 use crate::physics::run::space::Readout;
-use crate::physics::run::state::{Loads, Snapshot, State};
+use crate::physics::run::state::{Loads, Motion, Snapshot, State, OTHER_HOLDERS};
 use crate::physics::settings::Settings;
 use crate::physics::setup::scene::Scene;
 
@@ -39,6 +40,23 @@ impl<S: Readout, I: Scheme> Run<S, I> {
         // The sheet starts at rest wherever the anchor is and however the holder is turned.
         state.anchor[..dim].copy_from_slice(&loads.anchor[..dim]);
         state.rotation = planar(&loads.rotation, dim);
+        for (m, p) in state.holders.iter_mut().zip(&loads.holders) {
+            m.anchor[..dim].copy_from_slice(&p.anchor[..dim]);
+            m.rotation = planar(&p.rotation, dim);
+        }
+        let holder_ends = scene.moving_holders().iter().map(|h| holders::spring_ends(scene, h)).collect();
+        let holder_arms = scene
+            .moving_holders()
+            .iter()
+            .map(|h| {
+                let far = |&s: &usize| (0..dim).map(|i| (scene.rest[s * dim + i] - h.pivot[i]).powi(2)).sum::<f64>().sqrt();
+                h.slots.iter().map(far).fold(0.0, f64::max)
+            })
+            .collect();
+        let mut holder_nodes = Vec::new();
+        for (j, h) in scene.moving_holders().iter().enumerate() {
+            holder_nodes.extend(scene.slot_of_node.iter().enumerate().filter(|(_, s)| h.slots.contains(s)).map(|(node, _)| (j, node)));
+        }
         let local = turn_loads(loads, &rotation(&state.rotation), dim);
         let mut run = Run {
             outputs: Outputs::new(scene, settings.n_modes),
@@ -61,9 +79,14 @@ impl<S: Readout, I: Scheme> Run<S, I> {
             arm,
             rest_moment,
             local,
+            holder_ends,
+            holder_arms,
+            holder_nodes,
             scheme: PhantomData,
         };
         run.space.apply_loads(&mut run.work);
+        run.place_holders_now();
+        run.start_at_static_response()?;
         if run.state.rotation != [0.0; 3] {
             run.space.turn(&Frame { gravity: local.gravity, load: local.point_load, spin: [0.0; 3] }, &mut run.work);
         }
@@ -71,6 +94,60 @@ impl<S: Readout, I: Scheme> Run<S, I> {
         run.check_stable_step_cost()?;
         run.refresh_outputs();
         Ok(run)
+    }
+
+    /// The motion of the first holder (the frame) in the state, with the
+    /// anchor's velocity `rate` and the spin `spin` over the coming step.
+    fn first_motion(&self, rate: [f64; 3], spin: [f64; 3]) -> Motion {
+        Motion { anchor: self.state.anchor, anchor_rate: rate, rotation: self.state.rotation, spin }
+    }
+
+    /// Places the slots of the holders that move on their own where
+    /// `others` put them `tau` after the state's time, in the frame where
+    /// `first` puts the first holder then (`docs/method.md`, section 9);
+    /// the forces of the work are no longer those of the state.
+    fn place_holders(&mut self, first: &Motion, others: &[Motion; OTHER_HOLDERS], tau: f64) {
+        let moving = self.space.scene().moving_holders().len();
+        if moving == 0 {
+            return;
+        }
+        let at: [Placement; OTHER_HOLDERS] = std::array::from_fn(|j| Placement::after(&others[j], tau));
+        holders::place(self.space.scene(), &Placement::after(first, tau), &at[..moving], self.space.slots_mut(&mut self.work));
+        self.current = false;
+    }
+
+    /// [`Self::place_holders`] at the state.
+    fn place_holders_now(&mut self) {
+        let (first, others) = (self.first_motion(self.state.anchor_rate, self.state.spin), self.state.holders);
+        self.place_holders(&first, &others, 0.0);
+    }
+
+    /// Starts the sheet at rest where the holders' static pull puts it when
+    /// a holder other than the first is away from its place relative to the
+    /// first: the linear static response at rest (see
+    /// [`crate::physics::setup::basis::static_response`]), as the space holds it.
+    fn start_at_static_response(&mut self) -> Result<(), PhysicsError> {
+        let scene = self.space.scene();
+        let d = scene.dim;
+        let x = self.space.slots_mut(&mut self.work);
+        let away = scene.moving_holders().iter().flat_map(|h| &h.slots).any(|&s| (0..d).any(|i| x[s * d + i] != scene.rest[s * d + i]));
+        if !away {
+            return Ok(());
+        }
+        let x = x.to_vec();
+        let u = crate::physics::setup::basis::static_response(self.space.scene(), &x)?;
+        if u.iter().all(|&c| c == 0.0) {
+            return Ok(());
+        }
+        let mut dy = vec![0.0; self.state.len()];
+        match (self.space.layout().kept_modes, self.space.modes()) {
+            (Some(_), Some(basis)) => basis.project_displacement(&self.space.scene().dof_mass, &u, &mut dy),
+            _ => dy.copy_from_slice(&u),
+        }
+        for (y, d) in self.state.y.iter_mut().zip(&dy) {
+            *y += d;
+        }
+        Ok(())
     }
 
     /// The space the run steps.
@@ -296,6 +373,35 @@ impl<S: Readout, I: Scheme> Steps for Run<S, I> {
             let cause = StepFailure::TurnTooFast { rate: turn_rate, limit: 0.5 * self.spacing / (self.arm * dt), reach: self.arm, dt };
             return Err(PhysicsError::StepFailed { time: self.state.time, cause });
         }
+        // Every other holder moves linearly and turns at a constant rate to its target too;
+        // the free nodes keep their velocity and follow through the springs.
+        let moving = self.scene().moving_holders().len();
+        let mut others = self.state.holders;
+        let mut relative = moving > 0 && (rate != [0.0; 3] || spin != [0.0; 3]);
+        let mut pushed = 0.0f64;
+        for (j, m) in others.iter_mut().enumerate().take(moving) {
+            let target = self.loads().holders[j];
+            let new_rate: [f64; 3] = std::array::from_fn(|i| if i < d { (target.anchor[i] - m.anchor[i]) / h } else { 0.0 });
+            let new_spin = frame::spin(&m.rotation, &planar(&target.rotation, d), h);
+            let change = |a: &[f64; 3], b: &[f64; 3]| norm(&std::array::from_fn(|i| a[i] - b[i]));
+            let speed = change(&new_rate, &m.anchor_rate) + change(&new_spin, &m.spin) * self.holder_arms[j];
+            if !speed.is_finite() || speed * dt > 0.5 * self.spacing {
+                let cause = StepFailure::HolderTooFast { holder: j + 2, speed, limit: 0.5 * self.spacing / dt, dt };
+                return Err(PhysicsError::StepFailed { time: self.state.time, cause });
+            }
+            m.anchor_rate = new_rate;
+            m.spin = new_spin;
+            relative |= new_rate != [0.0; 3] || new_spin != [0.0; 3];
+            pushed = pushed.max(norm(&new_rate) + norm(&new_spin) * self.holder_arms[j]);
+        }
+        let first = self.first_motion(rate, spin);
+        let (mut first_end, mut others_end) = (first, others);
+        first_end.anchor[..d].copy_from_slice(&self.loads().anchor[..d]);
+        first_end.rotation = target;
+        for (j, m) in others_end.iter_mut().enumerate().take(moving) {
+            m.anchor[..d].copy_from_slice(&self.loads().holders[j].anchor[..d]);
+            m.rotation = planar(&self.loads().holders[j].rotation, d);
+        }
         self.backup.copy_from(&self.state);
         let start = rotation(&self.state.rotation);
         if turning {
@@ -315,15 +421,28 @@ impl<S: Readout, I: Scheme> Steps for Run<S, I> {
                 let frame = self.frame(&start, (i + 1) as f64 * dt, &spin);
                 self.space.turn(&frame, &mut self.work);
             }
+            if relative {
+                // The holders as they are at the step's end: the last one exactly at their targets.
+                if i + 1 == steps {
+                    self.place_holders(&first_end, &others_end, 0.0);
+                } else {
+                    self.place_holders(&first, &others, (i + 1) as f64 * dt);
+                }
+            }
             result = self.step_internal(dt);
             if result.is_err() {
                 break;
             }
         }
         // A spinning frame can give the sheet the kinetic energy of its far end at the frame's speed.
-        let spun = self.free_mass * (norm(&spin) * self.arm).powi(2) * self.loads().weight_max().powi(2);
+        // A spinning frame can give the sheet the kinetic energy of its far end at the frame's
+        // speed; a holder moving on its own, that of its speed (and of the springs it stretches).
+        let spun = self.free_mass * ((norm(&spin) * self.arm).powi(2) + pushed.powi(2)) * self.loads().weight_max().powi(2);
         if let Err(cause) = result.and_then(|_| self.check_state(dt, energy_before + spun)) {
             self.state.copy_from(&self.backup);
+            if relative {
+                self.place_holders_now();
+            }
             if turning {
                 self.space.apply_loads(&mut self.work);
                 if self.turned() {
@@ -339,6 +458,9 @@ impl<S: Readout, I: Scheme> Steps for Run<S, I> {
         let target_anchor = self.loads().anchor;
         self.state.anchor[..d].copy_from_slice(&target_anchor[..d]);
         self.state.anchor_rate = rate;
+        for (m, end) in self.state.holders.iter_mut().zip(&others_end).take(moving) {
+            *m = *end;
+        }
         if turning {
             self.state.rotation = target;
             self.state.spin = spin;
@@ -449,6 +571,7 @@ impl<S: Readout, I: Scheme> Steps for Run<S, I> {
         self.work.as_mut().clone_from(&s.loads);
         self.state.copy_from(&s.state);
         self.apply_loads();
+        self.place_holders_now();
         self.evaluate_forces();
         self.refresh_outputs();
         Ok(())

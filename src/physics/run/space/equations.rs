@@ -120,6 +120,11 @@ pub trait Space: Constants + Send + Sized + 'static {
     /// (in every method above that takes C). Called after
     /// [`Space::apply_loads`], and for every internal step while the holder turns.
     fn turn(&self, frame: &Frame, w: &mut Self::Work);
+    /// The slot positions the force evaluations read (every slot, `dim`
+    /// values each): the run writes the held slots of the holders that
+    /// move on their own there ([`crate::physics::run::holders::place`]);
+    /// the free slots are the space's to write.
+    fn slots_mut<'w>(&self, w: &'w mut Self::Work) -> &'w mut [f64];
 }
 
 /// What is read from a space's coordinates: positions, velocities,

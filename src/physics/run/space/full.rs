@@ -362,6 +362,10 @@ impl Space for Full {
         w.spin = frame.spin;
     }
 
+    fn slots_mut<'w>(&self, w: &'w mut FullWork) -> &'w mut [f64] {
+        &mut w.x
+    }
+
     /// u' += c x (x_rest + u - X0) on every free node.
     fn add_rotation_rate(&self, _w: &FullWork, c: &[f64; 3], u: &[f64], v: &mut [f64]) {
         let d = self.scene.dim;

@@ -118,6 +118,12 @@ impl ReducedForce for Cubature {
         }
     }
 
+    /// Held slots other than at rest are refused with a cubature (its
+    /// springs are chosen for one holder); they are written here all the same.
+    fn slots_mut<'w>(&self, w: &'w mut CubatureWork) -> &'w mut [f64] {
+        &mut w.x
+    }
+
     fn positions<'w>(&self, _scene: &Scene, modes: &Modes, q: &[f64], w: &'w mut CubatureWork) -> &'w [f64] {
         Self::expand(modes, q, w);
         &w.x

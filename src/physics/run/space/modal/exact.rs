@@ -52,6 +52,10 @@ impl ReducedForce for Exact {
         add_reduced_tangent(scene, &w.x, &modes.basis.phi, modes.basis.r, false, kr, &mut w.tangent);
     }
 
+    fn slots_mut<'w>(&self, w: &'w mut ExactWork) -> &'w mut [f64] {
+        &mut w.x
+    }
+
     /// The positions of the last evaluation, which was at `q`.
     fn positions<'w>(&self, _scene: &Scene, _modes: &Modes, _q: &[f64], w: &'w mut ExactWork) -> &'w [f64] {
         &w.x

@@ -255,6 +255,10 @@ impl<F: ReducedForce> Space for Modal<F> {
         w.turning = true;
     }
 
+    fn slots_mut<'w>(&self, w: &'w mut Self::Work) -> &'w mut [f64] {
+        self.force.slots_mut(&mut w.force)
+    }
+
     fn force(&self, q: &[f64], w: &mut Self::Work, h: &mut [f64]) {
         // F = Phi^T (f + M g)
         self.force.project(&self.scene, &self.modes, q, &mut w.force, h);
@@ -452,8 +456,13 @@ impl<F: ReducedForce> Readout for Modal<F> {
 
     /// x* + Phi q at one slot, summed mode by mode as [`Modes::expand`] does
     /// (the same bits), without expanding the others; held slots stay at x*.
-    fn slot_position(&self, q: &[f64], slot: usize, _w: &mut Self::Work) -> [f64; 3] {
+    fn slot_position(&self, q: &[f64], slot: usize, w: &mut Self::Work) -> [f64; 3] {
         let (n, d) = (self.modes.basis.n, self.scene.dim);
+        if slot * d >= n {
+            // A held slot: where its holder put it.
+            let x = self.force.slots_mut(&mut w.force);
+            return std::array::from_fn(|i| if i < d { x[slot * d + i] } else { 0.0 });
+        }
         let mut x = [0.0; 3];
         for i in 0..d {
             let k = slot * d + i;

@@ -25,6 +25,9 @@ pub trait ReducedForce: Send + Sized + 'static {
     fn project(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &mut Self::Work, out: &mut [f64]);
     /// Adds Phi^T K(x) Phi (r x r, column-major) at the last [`Self::project`] to `kr`.
     fn add_tangent(&self, scene: &Scene, modes: &Modes, w: &mut Self::Work, kr: &mut [f64]);
+    /// The slot positions the evaluations read, whose held slots the run
+    /// places (see [`crate::physics::run::space::Space::slots_mut`]).
+    fn slots_mut<'w>(&self, w: &'w mut Self::Work) -> &'w mut [f64];
     /// Slot positions at `q`, the coordinates of the last [`Self::project`].
     fn positions<'w>(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &'w mut Self::Work) -> &'w [f64];
     /// Elastic energy of every spring at `q`, the coordinates of the last [`Self::project`] [J].

@@ -1,0 +1,227 @@
+//! Several holders (`nHolders`; `docs/method.md`, section 9): the split of
+//! the held nodes, the refusals, each holder's force and torque adding up
+//! to the momentum balance, every mode kept equal to full space with the
+//! holders moving apart, the custom pattern naming the top corners equal
+//! to them bit for bit, and the reduced model with and without the
+//! holders' constraint modes against full space (a sheet held at its two
+//! top corners, pulled taut and swung).
+
+use modal_mass_spring::physics::*;
+
+/// The paper's 2D sheet of `n` x `n` nodes (0.1 m, 0.01 kg, 50 N/m, shear
+/// springs) hung from its top corners, each by its own holder.
+fn corners(n: usize, dim: usize) -> Grid {
+    Grid {
+        columns: n,
+        rows: n,
+        dim,
+        spacing: 0.1,
+        node_mass: 0.01,
+        spring_stiffness: 50.0,
+        shear_springs: true,
+        bending_springs: false,
+        aux_stiffness: if dim == 3 { 0.05 } else { 0.0 },
+        fixed_nodes: FixedNodes::TopCorners,
+        holders: 2,
+        holder_of_node: Vec::new(),
+    }
+}
+
+fn loads(modes: usize, alpha: f64) -> Loads {
+    Loads { damping_alpha: alpha, ..Loads::physical(modes) }
+}
+
+/// `n` load vectors with a static correction, prepared for the holders' motion.
+fn reduced_with(n: usize, constraint_modes: bool) -> Settings {
+    let mut s = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, n);
+    s.mode_selection = ModeSelection::Load;
+    s.static_correction = true;
+    s.anchor_motion = true;
+    s.constraint_modes = constraint_modes;
+    s
+}
+
+/// 8 load vectors with a static correction, prepared for the holders' motion.
+fn reduced(constraint_modes: bool) -> Settings {
+    reduced_with(8, constraint_modes)
+}
+
+fn full() -> Settings {
+    Settings::new(Reduction::Full, Integrator::NewmarkExplicit, 0)
+}
+
+/// The second holder's target.
+fn move_second(sim: &mut Simulator, to: [f64; 3]) {
+    sim.edit_loads(&mut |l| l.holders[0].anchor = to).unwrap();
+}
+
+fn largest_difference(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+}
+
+fn norm(v: &[f64; 3]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+#[test]
+fn held_nodes_split_by_column() {
+    let mut g = corners(5, 2);
+    let s = g.build().unwrap();
+    assert_eq!(s.holders.len(), 2);
+    assert_eq!((s.holders[0].slots.len(), s.holders[1].slots.len()), (1, 1));
+    assert_eq!(s.holders[1].pivot, [0.4, 0.0, 0.0]);
+    g.fixed_nodes = FixedNodes::TopRow;
+    let s = g.build().unwrap();
+    // 5 columns, 2 holders: columns 0-2 and 3-4.
+    assert_eq!((s.holders[0].slots.len(), s.holders[1].slots.len()), (3, 2));
+    assert_eq!(s.holders[1].pivot, [0.30000000000000004, 0.0, 0.0]);
+    // The spring between the halves joins two holders: it stays in the scene.
+    let between = s.springs.iter().filter(|sp| sp.a >= s.n_free && sp.b >= s.n_free).count();
+    assert_eq!(between, 1);
+    g.holders = 1;
+    assert!(g.build().unwrap().springs.iter().all(|sp| sp.a < s.n_free || sp.b < s.n_free));
+}
+
+#[test]
+fn bad_patterns_are_refused() {
+    let mut g = corners(4, 2);
+    g.holders = 3;
+    assert!(matches!(g.build(), Err(PhysicsError::Holders(HolderProblem::TooFewColumns { holders: 3, columns: 2 }))));
+    g.fixed_nodes = FixedNodes::Custom;
+    g.holder_of_node = vec![0; 16];
+    assert_eq!(g.build().unwrap_err(), PhysicsError::Holders(HolderProblem::NoHeldNode));
+    g.holder_of_node[0] = 1;
+    g.holder_of_node[3] = 2;
+    assert_eq!(g.build().unwrap_err(), PhysicsError::Holders(HolderProblem::NoNode { holder: 3 }));
+    g.holder_of_node[5] = 4;
+    assert!(matches!(g.build(), Err(PhysicsError::Holders(HolderProblem::IdTooLarge { row: 1, col: 1, id: 4, holders: 3 }))));
+    g.holder_of_node.pop();
+    assert!(matches!(g.build(), Err(PhysicsError::Holders(HolderProblem::PatternLength { len: 15, expected: 16 }))));
+    g.holders = 5;
+    assert!(matches!(g.build(), Err(PhysicsError::Invalid { quantity: Quantity::Holders, .. })));
+    // A holder the scene does not have may not move; the loads are kept.
+    let mut sim = Simulator::new(corners(4, 2).build().unwrap(), &full(), &loads(0, 0.0)).unwrap();
+    let e = sim.edit_loads(&mut |l| l.holders[1].anchor = [0.1, 0.0, 0.0]).unwrap_err();
+    assert_eq!(e, PhysicsError::Holders(HolderProblem::Absent { holder: 3, holders: 2 }));
+    assert_eq!(sim.loads().holders[1].anchor, [0.0; 3]);
+    // The cubature's springs are chosen for one holder.
+    let mut cubature = reduced(true);
+    cubature.force_evaluation = ForceEvaluation::Cubature;
+    let e = Simulator::new(corners(4, 2).build().unwrap(), &cubature, &loads(8, 0.0)).err().unwrap();
+    assert_eq!(e, PhysicsError::Holders(HolderProblem::Cubature));
+}
+
+#[test]
+fn custom_corners_are_the_top_corners_bit_for_bit() {
+    let mut custom = corners(6, 2);
+    custom.fixed_nodes = FixedNodes::Custom;
+    custom.holder_of_node = vec![0; 36];
+    custom.holder_of_node[0] = 1;
+    custom.holder_of_node[5] = 2;
+    for settings in [full(), reduced(true)] {
+        let n = settings.n_modes;
+        let mut a = Simulator::new(corners(6, 2).build().unwrap(), &settings, &loads(n, 1.0)).unwrap();
+        let mut b = Simulator::new(custom.build().unwrap(), &settings, &loads(n, 1.0)).unwrap();
+        for k in 0..40 {
+            let to = [0.002 * k as f64, 0.001 * k as f64, 0.0];
+            move_second(&mut a, to);
+            move_second(&mut b, to);
+            a.do_step(0.01).unwrap();
+            b.do_step(0.01).unwrap();
+        }
+        assert_eq!(a.positions(), b.positions());
+        assert_eq!(a.holder_force(1), b.holder_force(1));
+    }
+}
+
+/// The holders' forces add up to the momentum balance, and with every mode
+/// kept the modal space is the full space's to round-off while the
+/// holders move apart and turn.
+#[test]
+fn every_mode_kept_is_full_space_and_the_forces_add_up() {
+    for dim in [2, 3] {
+        let grid = corners(5, dim);
+        let dofs = grid.build().unwrap().n_dofs();
+        let mut all = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, dofs);
+        all.anchor_motion = true;
+        all.anchor_rotation = true;
+        let mut f = Simulator::new(grid.build().unwrap(), &full(), &loads(0, 0.5)).unwrap();
+        let mut m = Simulator::new(grid.build().unwrap(), &all, &loads(dofs, 0.5)).unwrap();
+        let (mut worst, mut worst_force, mut sum_error) = (0.0f64, 0.0f64, 0.0f64);
+        for k in 0..60 {
+            let t = 0.01 * k as f64;
+            for sim in [&mut f, &mut m] {
+                sim.edit_loads(&mut |l| {
+                    l.holders[0].anchor = [0.05 * t, -0.03 * t, 0.02 * t];
+                    l.holders[0].rotation = [0.0, 0.0, 0.3 * t];
+                    l.anchor = [0.0, 0.01 * t, 0.0];
+                })
+                .unwrap();
+                sim.do_step(0.01).unwrap();
+                let total = sim.anchor_force();
+                let sum: [f64; 3] = std::array::from_fn(|i| sim.holder_force(0)[i] + sim.holder_force(1)[i]);
+                sum_error = sum_error.max(norm(&std::array::from_fn(|i| sum[i] - total[i])) / norm(&total));
+            }
+            worst = worst.max(largest_difference(f.positions(), m.positions()));
+            for k in 0..2 {
+                let (a, b) = (f.holder_force(k), m.holder_force(k));
+                worst_force = worst_force.max(norm(&std::array::from_fn(|i| a[i] - b[i])));
+            }
+        }
+        println!("{dim}D, every mode: positions within {worst:.2e} m, holder forces within {worst_force:.2e} N, sums within {sum_error:.1e}");
+        assert!(worst < 1e-9, "{dim}D: {worst}");
+        assert!(worst_force < 1e-8, "{dim}D: {worst_force}");
+        assert!(sum_error < 1e-12, "{dim}D: {sum_error}");
+    }
+}
+
+/// Holder 2 moved `to` over 1 s, then everything settles under damping:
+/// positions and each holder's force of `settings` against full space,
+/// relative to the weight per holder.
+fn settled(grid: &Grid, settings: &Settings, to: [f64; 3]) -> (Vec<f64>, [[f64; 3]; 2]) {
+    let n = settings.n_modes;
+    let mut sim = Simulator::new(grid.build().unwrap(), settings, &loads(n, 6.0)).unwrap();
+    for k in 1..=100 {
+        move_second(&mut sim, to.map(|c| c * k as f64 / 100.0));
+        sim.do_step(0.01).unwrap();
+    }
+    for _ in 0..800 {
+        sim.do_step(0.01).unwrap();
+    }
+    (sim.positions().to_vec(), [sim.holder_force(0), sim.holder_force(1)])
+}
+
+#[test]
+fn a_reduced_model_with_constraint_modes_holds_the_stretched_sheet() {
+    let grid = corners(10, 2);
+    let weight = 0.01 * 98.0 * 9.81 / 2.0;
+    // (holder 2's move, basis size, tolerance on positions [m] and on each holder's force [share of the weight per holder]);
+    // the 8 vectors with the move upwards are printed, not held to 2 %: at rest they are already 2.2 % off.
+    let cases = [
+        ([0.0, 0.0, 0.0], 8, None),
+        ([0.03, 0.0, 0.0], 8, Some((0.01, 0.02))),
+        ([0.18, 0.0, 0.0], 8, Some((0.03, 0.06))),
+        ([0.0, 0.05, 0.0], 8, None),
+        ([0.0, 0.05, 0.0], 12, Some((0.01, 0.02))),
+    ];
+    for (to, n, within) in cases {
+        let (x_full, f_full) = settled(&grid, &full(), to);
+        let sum: [f64; 3] = std::array::from_fn(|i| f_full[0][i] + f_full[1][i]);
+        assert!((sum[1] + 2.0 * weight).abs() < 1e-6 * weight, "{sum:?}");
+        for constraint_modes in [true, false] {
+            let (x, f) = settled(&grid, &reduced_with(n, constraint_modes), to);
+            let dx = largest_difference(&x, &x_full);
+            let df = (0..2).map(|k| norm(&std::array::from_fn(|i| f[k][i] - f_full[k][i])) / weight).fold(0.0, f64::max);
+            let total: [f64; 3] = std::array::from_fn(|i| f[0][i] + f[1][i]);
+            println!(
+                "holder 2 moved {to:?} m, {n} load vectors + static correction{}: positions within {dx:.2e} m, holder forces within {:.2} % of the weight per holder",
+                if constraint_modes { " + constraint modes" } else { "" },
+                100.0 * df
+            );
+            assert!((total[1] + 2.0 * weight).abs() < 1e-6 * weight && total[0].abs() < 1e-6 * weight, "{total:?}");
+            if let (true, Some((m, share))) = (constraint_modes, within) {
+                assert!(dx < m && df < share, "{to:?}: {dx} m, {df}");
+            }
+        }
+    }
+}
