@@ -21,6 +21,12 @@
 //!   vectors (`modeSelection = trained`), exact and cubature forces, default
 //!   settings otherwise, without and with the node positions read after each step.
 //!
+//! - `holders/paper-2d-top-row`: a communication step of 0.01 s with 1, 2
+//!   and 4 holders (the top row split among them), every holder but the
+//!   first moving on a circle of its own, modal (8 load vectors, a static
+//!   correction, `anchorMotion`: the constraint modes in the basis) and full
+//!   space, the force and torque of every holder read after each step.
+//!
 //! cargo bench --bench step
 
 use std::ffi::CString;
@@ -247,6 +253,37 @@ fn steps(inst: fmi3Instance, iters: u64, h: f64, time: &mut f64, mut positions: 
     t.elapsed()
 }
 
+fn holders(c: &mut Criterion) {
+    let name = "paper-2d-top-row";
+    let mut group = c.benchmark_group(format!("holders/{name}"));
+    let mut modal = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 8);
+    modal.mode_selection = ModeSelection::Load;
+    modal.static_correction = true;
+    modal.anchor_motion = true;
+    for (space, s) in [("modal-r8", modal), ("full", Settings::new(Reduction::Full, Integrator::NewmarkExplicit, 0))] {
+        for n in [1usize, 2, 4] {
+            let mut p = canonical_scenes::canonical(name).unwrap().grid;
+            p.holders = n;
+            let (mut sim, _) = simulator(&p, &s);
+            let mut t = 0.0;
+            group.bench_function(BenchmarkId::new(space, format!("{n} holders")), |b| {
+                b.iter(|| {
+                    t += 0.01;
+                    sim.edit_loads(&mut |l| {
+                        for (k, h) in l.holders.iter_mut().enumerate().take(n - 1) {
+                            let phase = t * (3.0 + k as f64);
+                            h.anchor = [0.01 * phase.cos(), 0.01 * phase.sin(), 0.0];
+                        }
+                    })
+                    .unwrap();
+                    sim.do_step(0.01).unwrap();
+                    (0..n).map(|k| sim.holder_force(k)[1] + sim.holder_torque(k)[2]).sum::<f64>()
+                })
+            });
+        }
+    }
+}
+
 fn residual_check(c: &mut Criterion) {
     for n in [30u64, 100] {
         let mut group = c.benchmark_group(format!("residual_check/cloth-3d-{n}x{n}"));
@@ -286,6 +323,6 @@ fn trained(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(2));
-    targets = do_step, internal_step, cubature, residual_check, trained
+    targets = do_step, internal_step, cubature, residual_check, trained, holders
 }
 criterion_main!(benches);

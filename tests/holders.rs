@@ -225,3 +225,41 @@ fn a_reduced_model_with_constraint_modes_holds_the_stretched_sheet() {
         }
     }
 }
+
+/// A snapshot taken while holder 2 moves and turns resumes the run bit for
+/// bit, and a step the second holder cannot follow is discarded with the
+/// state kept.
+#[test]
+fn snapshots_resume_and_a_jerk_is_discarded() {
+    for settings in [full(), reduced(true)] {
+        let n = settings.n_modes;
+        let mut a = Simulator::new(corners(6, 3).build().unwrap(), &settings, &loads(n, 0.5)).unwrap();
+        let drive = |sim: &mut Simulator, k: usize| {
+            let t = 0.01 * k as f64;
+            sim.edit_loads(&mut |l| {
+                l.holders[0].anchor = [0.05 * t.sin(), 0.02 * t, -0.03 * t];
+                l.holders[0].rotation = [0.1 * t, 0.0, 0.4 * t];
+            })
+            .unwrap();
+            sim.do_step(0.01).unwrap();
+        };
+        for k in 0..20 {
+            drive(&mut a, k);
+        }
+        let saved = a.snapshot();
+        let mut b = Simulator::new(corners(6, 3).build().unwrap(), &settings, &loads(n, 0.5)).unwrap();
+        b.restore(&saved).unwrap();
+        for k in 20..40 {
+            drive(&mut a, k);
+            drive(&mut b, k);
+        }
+        assert_eq!(a.positions(), b.positions());
+        assert_eq!(a.velocities(), b.velocities());
+        assert_eq!(a.holder_force(1), b.holder_force(1));
+        let before = a.snapshot();
+        a.edit_loads(&mut |l| l.holders[0].anchor = [10.0, 0.0, 0.0]).unwrap();
+        let e = a.do_step(0.01).unwrap_err();
+        assert!(matches!(e, PhysicsError::StepFailed { cause: StepFailure::HolderTooFast { holder: 2, .. }, .. }), "{e}");
+        assert_eq!(a.snapshot().state, before.state);
+    }
+}

@@ -333,6 +333,27 @@ fn extremes() -> Vec<Extreme> {
             compare: true,
         },
         Extreme {
+            label: "two holders (nHolders 2, anchorMotion true), holder 2 set a fifth of the width out before initialization, 1 s",
+            applies: all,
+            set: |s| vec![(vr::N_HOLDERS, U(2)), (vr::ANCHOR_MOTION, B(true)), (vr::ANCHOR2_X, F(vec![0.1 * (s.nx - 1) as f64 / 5.0]))],
+            t_end: one_second,
+            steps: &[0.01],
+            gravity: None,
+            compare: true,
+        },
+        Extreme {
+            label: "two holders, holder 2 set half the width out and up (springs next to it stretched far beyond 100 %), 0.5 s",
+            applies: all,
+            set: |s| {
+                let w = 0.1 * (s.nx - 1) as f64;
+                vec![(vr::N_HOLDERS, U(2)), (vr::ANCHOR_MOTION, B(true)), (vr::ANCHOR2_X, F(vec![0.5 * w])), (vr::ANCHOR2_Y, F(vec![0.5 * w]))]
+            },
+            t_end: |_, _| 0.5,
+            steps: &[0.01],
+            gravity: None,
+            compare: false,
+        },
+        Extreme {
             label: "linearized at the equilibrium under gravity 1e4 m/s² along -y, 0.2 s",
             applies: all,
             set: |_| vec![(vr::LINEARIZATION, I(2)), (vr::GRAVITY, F(vec![0.0, -1e4, 0.0]))],

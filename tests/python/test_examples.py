@@ -55,3 +55,24 @@ def test_mode_gallery(default_fmu, tmp_path):
     assert any("symmetry +1.000" in line for line in lines) and any("symmetry -1.000" in line for line in lines)
     out = run("mode_gallery.py", default_fmu, "--dimension", "2", "--modes", "4", "--mode-selection", "lowest", "--out", str(png))
     assert len([line for line in out.splitlines() if line.startswith("mode ")]) == 4
+
+
+def test_two_hands(default_fmu, tmp_path):
+    gif, png = tmp_path / "two_hands.gif", tmp_path / "two_hands.png"
+    out = run("two_hands.py", default_fmu, "--seconds", "0.5", "--out", str(gif), "--still", str(png))
+    assert gif.read_bytes()[:6] == b"GIF89a" and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", out
+    # Settled, the two hands carry the weight of the cloth between them.
+    m = re.search(r"add up to \((\S+), (\S+)\) N, the weight of the cloth's free nodes is \((\S+), (\S+)\) N", out)
+    fx, fy, wx, wy = (float(v) for v in m.groups())
+    assert wx == 0.0 and wy < -10.0 and abs(fx) < 1e-3 and abs(fy / wy - 1) < 1e-3, out
+    # The cloth pulls each hand down and inwards: the left one (holder 1) along +x, the right one along -x.
+    for hand, inwards in (("anchorForce", 1.0), ("anchor2Force", -1.0)):
+        m = re.search(rf"\({hand}\): x (\S+) to (\S+), y (\S+) to (\S+) N", out)
+        x_lo, x_hi, y_lo, y_hi = (float(v) for v in m.groups())
+        assert max(inwards * x_lo, inwards * x_hi) > 1.0 and min(inwards * x_lo, inwards * x_hi) > -0.1, out
+        assert y_lo < -1.0 and y_hi < 0.0, out
+    m = re.search(r"reduced against full: largest node distance (\S+) m", out)
+    assert float(m.group(1)) < 0.02, out
+    # The 3D variant: the hands swing across the plane, and the forces have a z component.
+    out = run("two_hands.py", default_fmu, "--dimension", "3", "--seconds", "0.5", "--out", "", "--still", "")
+    assert "nodes in 3D" in out and re.search(r"\(anchor2Force\): x \S+ to \S+, y \S+ to \S+, z ", out), out
