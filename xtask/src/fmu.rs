@@ -27,23 +27,27 @@ struct Options {
     nx: Option<u64>,
     ny: Option<u64>,
     modes: Option<u64>,
+    /// Other scalar start values, `--set NAME=VALUE`.
+    set: Vec<(String, f64)>,
     bake: bool,
     out: Option<PathBuf>,
 }
 
 const USAGE: &str = "\
-usage: cargo xtask fmu [--scene NAME] [--nx N] [--ny N] [--modes R] [--bake] [--out PATH]
+usage: cargo xtask fmu [--scene NAME] [--nx N] [--ny N] [--modes R] [--set NAME=VALUE]... [--bake] [--out PATH]
 
   --scene NAME  start values of a canonical scene (modelDescription/variables.toml)
   --nx N        nodes per row (the load column follows the middle of the row)
   --ny N        rows of nodes
   --modes R     modes kept (nModes)
+  --set NAME=VALUE  the start value of another scalar parameter (enumerations by
+                value), e.g. --set nHolders=2 --set fixedNodes=2; repeatable
   --bake        also resources/setup.bin: the modal set-up of these start values
   --out PATH    where the FMU goes (default target/fmu/NAME.fmu, NAME the scene or
                 ModalMassSpring, with -nxN, -nyN, -modesR appended when given)";
 
 fn parse(args: &[String]) -> Result<Option<Options>, cli::Error> {
-    let mut o = Options { scene: None, nx: None, ny: None, modes: None, bake: false, out: None };
+    let mut o = Options { scene: None, nx: None, ny: None, modes: None, set: Vec::new(), bake: false, out: None };
     let mut p = cli::parser(args);
     while let Some(arg) = p.next()? {
         match arg {
@@ -51,6 +55,12 @@ fn parse(args: &[String]) -> Result<Option<Options>, cli::Error> {
             Long("nx") => o.nx = Some(p.value()?.parse()?),
             Long("ny") => o.ny = Some(p.value()?.parse()?),
             Long("modes") => o.modes = Some(p.value()?.parse()?),
+            Long("set") => {
+                let pair = p.value()?.string()?;
+                let (name, value) = pair.split_once('=').ok_or_else(|| cli::Error::from(format!("--set {pair}: expected NAME=VALUE")))?;
+                let value: f64 = value.trim().parse().map_err(|_| cli::Error::from(format!("--set {pair}: {value} is not a number")))?;
+                o.set.push((name.trim().to_string(), value));
+            }
             Long("out") => o.out = Some(PathBuf::from(p.value()?)),
             Long("bake") => o.bake = true,
             arg if cli::is_help(&arg) => return Ok(None),
@@ -93,6 +103,13 @@ pub fn main(args: &[String]) -> Result<(), String> {
     if let (Some(nx), false) = (overrides.get("nx").map(|v| v[0]), overrides.contains_key("loadColumn")) {
         overrides.insert("loadColumn".into(), vec![(nx / 2.0).floor()]);
     }
+    for (name, value) in &o.set {
+        let var = spec.variable(name).ok_or(format!("--set {name}: no such variable"))?;
+        if !var.dimensions.is_empty() || !matches!(var.causality.as_str(), "parameter" | "structuralParameter" | "input") {
+            return Err(format!("--set {name}: only scalar parameters and inputs take a start value here"));
+        }
+        overrides.insert(name.clone(), vec![*value]);
+    }
     let check = |name: &str| -> Result<(), String> {
         let var = spec.variable(name).unwrap();
         let x = overrides.get(name).map(|v| v[0]);
@@ -102,7 +119,7 @@ pub fn main(args: &[String]) -> Result<(), String> {
             _ => Ok(()),
         }
     };
-    for name in ["nx", "ny", "nModes"] {
+    for name in ["nx", "ny", "nModes"].into_iter().chain(o.set.iter().map(|(n, _)| n.as_str())) {
         check(name)?;
     }
 
@@ -125,6 +142,9 @@ pub fn main(args: &[String]) -> Result<(), String> {
             if let Some(v) = v {
                 name.push_str(&format!("-{tag}{v}"));
             }
+        }
+        for (tag, v) in &o.set {
+            name.push_str(&format!("-{tag}{v}"));
         }
         target.join("fmu").join(format!("{name}.fmu"))
     });
