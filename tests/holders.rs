@@ -6,25 +6,13 @@
 //! holders' constraint modes against full space (a sheet held at its two
 //! top corners, pulled taut and swung).
 
+use modal_mass_spring::physics::setup::grid::paper;
 use modal_mass_spring::physics::*;
 
 /// The paper's 2D sheet of `n` x `n` nodes (0.1 m, 0.01 kg, 50 N/m, shear
 /// springs) hung from its top corners, each by its own holder.
 fn corners(n: usize, dim: usize) -> Grid {
-    Grid {
-        columns: n,
-        rows: n,
-        dim,
-        spacing: 0.1,
-        node_mass: 0.01,
-        spring_stiffness: 50.0,
-        shear_springs: true,
-        bending_springs: false,
-        aux_stiffness: if dim == 3 { 0.05 } else { 0.0 },
-        fixed_nodes: FixedNodes::TopCorners,
-        holders: 2,
-        holder_of_node: Vec::new(),
-    }
+    Grid { holders: 2, ..paper(n, n, dim, FixedNodes::TopCorners) }
 }
 
 fn loads(modes: usize, alpha: f64) -> Loads {

@@ -62,7 +62,6 @@ def ecos_run(models, h, stop, params, recorded, connections=()):
     name: ...} for every "instance::name" in recorded, at every
     communication point (t = 0 after initialization included)."""
     EcosLib.set_log_level("debug")
-    rows = []
     with EcosSimulationStructure() as structure:
         for name, path in models.items():
             structure.add_model(name, str(path))
@@ -70,19 +69,28 @@ def ecos_run(models, h, stop, params, recorded, connections=()):
         for source, sink, modifier in connections:
             structure.make_real_connection(source, sink, modifier)
         with EcosSimulation(structure=structure, step_size=h) as sim:
+            return recorded_run(sim, h, stop, recorded, "test")
 
-            def record():
-                rows.append([sim.get_time()] + [sim.get_real(n) for n in recorded])
 
-            class Recorder(SimulationListener):
-                def post(self, info):
-                    record()
+def recorded_run(sim, h, stop, recorded, parameter_set):
+    """Initializes the Ecos simulation `sim` with `parameter_set`, steps it
+    at h up to stop and returns {"time": ..., name: ...} for every
+    "instance::name" of recorded at every communication point (t = 0 after
+    initialization included)."""
+    rows = []
 
-            sim.add_listener("record", Recorder())
-            assert sim.init(parameter_set="test")
+    def record():
+        rows.append([sim.get_time()] + [sim.get_real(n) for n in recorded])
+
+    class Recorder(SimulationListener):
+        def post(self, info):
             record()
-            sim.step(int(round(stop / h)))
-            sim.terminate()
+
+    sim.add_listener("record", Recorder())
+    assert sim.init(parameter_set=parameter_set)
+    record()
+    sim.step(int(round(stop / h)))
+    sim.terminate()
     out = {"time": np.array([r[0] for r in rows])}
     for j, name in enumerate(recorded):
         out[name] = np.array([r[j + 1] for r in rows])

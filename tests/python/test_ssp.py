@@ -53,7 +53,7 @@ from conftest import ROOT, fmu_path, target_dir
 sys.path.insert(0, str(ROOT / "python"))
 import chain  # noqa: E402
 # ecospy's import and the skip, the helpers of the programmatic chain test
-from test_ecos import EcosLib, EcosSimulation, SimulationListener, assert_bitwise, fmu_messages  # noqa: E402
+from test_ecos import EcosLib, EcosSimulation, assert_bitwise, fmu_messages, recorded_run  # noqa: E402
 
 NS = {
     "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",
@@ -89,25 +89,8 @@ def ecos_ssp_run(path, h, stop, recorded, parameter_set=PARAMETER_SET):
     name: ...} for every "instance::name" of recorded at every
     communication point (t = 0 after initialization included)."""
     EcosLib.set_log_level("debug")
-    rows = []
     with EcosSimulation(step_size=h, ssp_path=str(path)) as sim:
-
-        def record():
-            rows.append([sim.get_time()] + [sim.get_real(n) for n in recorded])
-
-        class Recorder(SimulationListener):
-            def post(self, info):
-                record()
-
-        sim.add_listener("record", Recorder())
-        assert sim.init(parameter_set=parameter_set)
-        record()
-        sim.step(int(round(stop / h)))
-        sim.terminate()
-    out = {"time": np.array([r[0] for r in rows])}
-    for j, name in enumerate(recorded):
-        out[name] = np.array([r[j + 1] for r in rows])
-    return out
+        return recorded_run(sim, h, stop, recorded, parameter_set)
 
 
 def test_the_archive_is_chain_py(ssp, tmp_path):

@@ -176,7 +176,7 @@ pub fn constraint_vectors(
     if holders.is_empty() || !settings.constraint_modes || !(settings.anchor_motion || settings.anchor_rotation) {
         return Ok(Vec::new());
     }
-    let (d, n_free) = (scene.dim, scene.n_free);
+    let d = scene.dim;
     let mut vectors = Vec::new();
     let solver = ShiftedStiffness::new(scene, pattern, stiffness)?;
     for h in holders {
@@ -192,23 +192,10 @@ pub fn constraint_vectors(
         }
         for (i, lever) in motions {
             let shift = |slot: usize| -> f64 { lever.map_or(1.0, |j| scene.rest[slot * d + j] - h.pivot[j]) };
-            let mut f = vec![0.0; scene.n_dofs()];
-            for s in &scene.springs {
-                let (free, other) = match (s.a < n_free, s.b < n_free) {
-                    (true, false) => (s.a, s.b),
-                    (false, true) => (s.b, s.a),
-                    _ => continue,
-                };
-                if !held[other] || shift(other) == 0.0 {
-                    continue;
-                }
-                // The pull on the free end when the held end moves by b: K_e b.
-                let b = shift(other);
-                let dvec: Vec<f64> = (0..d).map(|c| point[s.b * d + c] - point[s.a * d + c]).collect();
-                for (r, fr) in f[free * d..(free + 1) * d].iter_mut().enumerate() {
-                    *fr += b * tangent_entry(&dvec, s.k, s.rest, r, i);
-                }
-            }
+            let f = held_pull(scene, point, |slot| {
+                let b = if held[slot] { shift(slot) } else { 0.0 };
+                std::array::from_fn(|c| if c == i { b } else { 0.0 })
+            });
             if f.iter().any(|&x| x != 0.0) {
                 vectors.push(solver.solve(&f));
             }
@@ -222,8 +209,17 @@ pub fn constraint_vectors(
 /// u = K_ff⁻¹ K_fh (x_h - X_h), K the stiffness at rest. Where a run
 /// starts when a holder is set away from its rest place before it starts.
 pub fn static_response(scene: &Scene, x: &[f64]) -> Result<Vec<f64>, PhysicsError> {
-    let (d, n_free) = (scene.dim, scene.n_free);
+    let d = scene.dim;
     let (pattern, stiffness) = crate::physics::run::forces::linearize(scene);
+    let f = held_pull(scene, &scene.rest, |slot| std::array::from_fn(|c| if c < d { x[slot * d + c] - scene.rest[slot * d + c] } else { 0.0 }));
+    Ok(ShiftedStiffness::new(scene, &pattern, &stiffness)?.solve(&f))
+}
+
+/// K_fh b: the pull on the free DOFs, through the springs' tangent at the
+/// slot positions `point`, of the held slots moved by `moved(slot)` (z
+/// ignored in 2D). A spring with one free end adds K_e b to that end.
+fn held_pull(scene: &Scene, point: &[f64], moved: impl Fn(usize) -> [f64; 3]) -> Vec<f64> {
+    let (d, n_free) = (scene.dim, scene.n_free);
     let mut f = vec![0.0; scene.n_dofs()];
     for s in &scene.springs {
         let (free, other) = match (s.a < n_free, s.b < n_free) {
@@ -231,16 +227,16 @@ pub fn static_response(scene: &Scene, x: &[f64]) -> Result<Vec<f64>, PhysicsErro
             (false, true) => (s.b, s.a),
             _ => continue,
         };
-        let moved: Vec<f64> = (0..d).map(|c| x[other * d + c] - scene.rest[other * d + c]).collect();
-        if moved.iter().all(|&m| m == 0.0) {
+        let b = moved(other);
+        if b[..d].iter().all(|&m| m == 0.0) {
             continue;
         }
-        let dvec: Vec<f64> = (0..d).map(|c| scene.rest[s.b * d + c] - scene.rest[s.a * d + c]).collect();
+        let dvec: Vec<f64> = (0..d).map(|c| point[s.b * d + c] - point[s.a * d + c]).collect();
         for (r, fr) in f[free * d..(free + 1) * d].iter_mut().enumerate() {
-            *fr += (0..d).map(|c| tangent_entry(&dvec, s.k, s.rest, r, c) * moved[c]).sum::<f64>();
+            *fr += (0..d).map(|c| tangent_entry(&dvec, s.k, s.rest, r, c) * b[c]).sum::<f64>();
         }
     }
-    Ok(ShiftedStiffness::new(scene, &pattern, &stiffness)?.solve(&f))
+    f
 }
 
 /// Entry (r, c) of a spring's tangent block k [u uᵀ + (1 - l0/l)(I - u uᵀ)], u = d / l.

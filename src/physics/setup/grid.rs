@@ -213,9 +213,9 @@ impl Grid {
 }
 
 /// The paper's sheet of `columns` x `rows` nodes (spacing 0.1 m, 0.01 kg,
-/// 50 N/m, shear springs; auxiliary springs of 0.05 N/m in 3D), for tests.
-#[cfg(test)]
-pub(crate) fn paper(columns: usize, rows: usize, dim: usize, fixed_nodes: FixedNodes) -> Grid {
+/// 50 N/m, shear springs; auxiliary springs of 0.05 N/m in 3D) on one
+/// holder, for tests and benchmarks.
+pub fn paper(columns: usize, rows: usize, dim: usize, fixed_nodes: FixedNodes) -> Grid {
     Grid {
         columns,
         rows,
