@@ -163,6 +163,44 @@ fn every_mode_kept_is_full_space_and_the_forces_add_up() {
     }
 }
 
+/// A net held at its four corners by four holders that move and turn on
+/// their own: every mode kept, the modal space is the full space's to
+/// round-off, and the four forces add up to the momentum balance.
+#[test]
+fn four_holders_at_the_corners() {
+    let mut grid = Grid { holders: 4, fixed_nodes: FixedNodes::Custom, ..paper(5, 5, 3, FixedNodes::TopRow) };
+    grid.holder_of_node = vec![0; 25];
+    (grid.holder_of_node[0], grid.holder_of_node[4], grid.holder_of_node[20], grid.holder_of_node[24]) = (1, 2, 3, 4);
+    let dofs = grid.build().unwrap().n_dofs();
+    let mut all = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, dofs);
+    all.anchor_motion = true;
+    all.anchor_rotation = true;
+    let mut f = Simulator::new(grid.build().unwrap(), &full(), &loads(0, 0.5)).unwrap();
+    let mut m = Simulator::new(grid.build().unwrap(), &all, &loads(dofs, 0.5)).unwrap();
+    let (mut worst, mut sum_error) = (0.0f64, 0.0f64);
+    for k in 0..50 {
+        let t = 0.01 * k as f64;
+        for sim in [&mut f, &mut m] {
+            sim.edit_loads(&mut |l| {
+                l.anchor = [-0.02 * t, 0.0, 0.01 * t];
+                for (j, h) in l.holders.iter_mut().enumerate() {
+                    let s = 1.0 + j as f64;
+                    h.anchor = [0.02 * s * t, -0.01 * t, 0.03 * (s * t).sin()];
+                    h.rotation = [0.0, 0.1 * s * t, 0.2 * t];
+                }
+            })
+            .unwrap();
+            sim.do_step(0.01).unwrap();
+            let total = sim.anchor_force();
+            let sum: [f64; 3] = std::array::from_fn(|i| (0..4).map(|k| sim.holder_force(k)[i]).sum());
+            sum_error = sum_error.max(norm(&std::array::from_fn(|i| sum[i] - total[i])) / norm(&total));
+        }
+        worst = worst.max(largest_difference(f.positions(), m.positions()));
+    }
+    println!("four holders, every mode: positions within {worst:.2e} m, forces add up within {sum_error:.1e}");
+    assert!(worst < 1e-9 && sum_error < 1e-12, "{worst} {sum_error}");
+}
+
 /// Holder 2 moved `to` over 1 s, then everything settles under damping:
 /// positions and each holder's force of `settings` against full space,
 /// relative to the weight per holder.
