@@ -376,3 +376,40 @@ fn pulled_taut_and_swung_by_two_hands() {
     }
     assert!(errors[&(32, true)].0 < 0.04, "{errors:?}");
 }
+
+/// Every scheme steps a sheet whose second holder moves and turns (the
+/// trigonometric one too: only holder 1's turning adds the Coriolis force
+/// it cannot take), and they agree.
+#[test]
+fn every_scheme_moves_the_second_holder() {
+    let grid = corners(6, 3);
+    let mut runs = Vec::new();
+    for (reduction, integrator) in [
+        (Reduction::Full, Integrator::NewmarkExplicit),
+        (Reduction::Full, Integrator::NewmarkImplicit),
+        (Reduction::Modal, Integrator::NewmarkExplicit),
+        (Reduction::Modal, Integrator::NewmarkImplicit),
+        (Reduction::Modal, Integrator::Trigonometric),
+    ] {
+        let mut s = if reduction == Reduction::Full { full() } else { reduced_with(24, true) };
+        s.integrator = integrator;
+        s.max_internal_step = 1e-3;
+        let n = s.n_modes;
+        let mut sim = Simulator::new(grid.build().unwrap(), &s, &loads(n, 1.0)).unwrap();
+        for k in 0..50 {
+            let t = 0.01 * k as f64;
+            sim.edit_loads(&mut |l| {
+                l.holders[0].anchor = [0.03 * t, 0.02 * (2.0 * t).sin(), -0.02 * t];
+                l.holders[0].rotation = [0.0, 0.2 * t, 0.3 * t];
+            })
+            .unwrap();
+            sim.do_step(0.01).unwrap_or_else(|e| panic!("{reduction:?} {integrator:?}: {e}"));
+        }
+        runs.push((format!("{reduction:?} {integrator:?}"), sim.positions().to_vec()));
+    }
+    for (label, x) in &runs[1..] {
+        let d = largest_difference(x, &runs[0].1);
+        println!("{label}: {d:.2e} m from full explicit");
+        assert!(d < 0.02, "{label}: {d}");
+    }
+}
