@@ -168,7 +168,6 @@ fn holders(problem: &HolderProblem, p: &Params) -> String {
         HolderProblem::Absent { holder, holders } => {
             format!("anchor{holder}X ... anchor{holder}RZ move holder {holder}, and nHolders = {holders}: only 0 is accepted for a holder that does not exist")
         }
-        HolderProblem::Cubature => "forceEvaluation = cubature chooses its springs for one holder; with nHolders > 1 use forceEvaluation = exact".into(),
     }
 }
 

@@ -310,9 +310,6 @@ pub enum HolderProblem {
     /// A holder that does not exist moved or turned.
     #[error("holder {holder} does not exist (there are {holders}); its displacement and rotation must stay 0")]
     Absent { holder: usize, holders: usize },
-    /// Several holders with a force model that leaves out springs.
-    #[error("the cubature's springs were chosen for one holder; several holders need exact forces")]
-    Cubature,
 }
 
 impl PhysicsError {

@@ -211,9 +211,6 @@ impl Simulator {
         }
         loads.validate(settings.n_modes)?;
         loads.validate_on(&scene)?;
-        if scene.holders.len() > 1 && settings.reduction == Reduction::Modal && settings.force_evaluation == ForceEvaluation::Cubature {
-            return Err(PhysicsError::Holders(crate::physics::error::HolderProblem::Cubature));
-        }
         Ok(Simulator(build(scene, settings, loads, prebuilt)?))
     }
 

@@ -25,6 +25,17 @@
 //!
 //! The set and its weights are trained at set-up by [`crate::physics::setup::cubature_training`]
 //! (on poses of a short exact reduced run) or taken from a bake.
+//!
+//! Holders that move on their own (`docs/method.md`, section 9) move the
+//! held end of the springs that end on their nodes, by δ from x*: those
+//! springs' change is added exactly, whatever the set,
+//!
+//! ```text
+//!     F~(q) += sum_{e at a moving holder} G_e^T (g_e(d0_e - G_e q ± δ_e) - g_e(d0_e - G_e q)),
+//! ```
+//!
+//! (+ where the held end is b, − where it is a), with its tangent and energy;
+//! nothing changes while every holder is in its place.
 
 use super::reduced::{ForceSetup, Modes, ReducedForce};
 use crate::physics::error::PhysicsError;
@@ -50,13 +61,31 @@ pub struct Cubature {
     energy_offset: f64,
     /// Every spring, for the outputs at communication points.
     exact: SpringForces,
+    /// The springs with one free end and one on a holder that moves on its own.
+    held: Vec<HeldSpring>,
     /// Relative error of F - F0 on the training poses and on the held-out ones.
     pub training_error: f64,
     pub held_out_error: f64,
 }
 
+/// A spring from a free slot to a slot of a holder that moves on its own.
+struct HeldSpring {
+    /// G = Phi_a - Phi_b, D x r row-major (zero at the held end).
+    g: Vec<f64>,
+    d0: [f64; 3],
+    k: f64,
+    l0: f64,
+    /// The held slot, and +1 when it is the spring's end b, -1 when it is a.
+    slot: usize,
+    sign: f64,
+}
+
 /// The kept springs' vectors of the last evaluation, and the outputs' scratch.
 pub struct CubatureWork {
+    /// Per held spring: its vector with the holder in place and moved (2 D
+    /// values), and whether it moved, at the last evaluation.
+    held_d: Vec<f64>,
+    held_moved: Vec<bool>,
     /// d = d0 - G q per kept spring.
     d: Vec<f64>,
     /// Slot positions, spring forces and elastic energy of every spring at
@@ -91,6 +120,8 @@ impl ReducedForce for Cubature {
 
     fn work(&self, scene: &Scene, modes: &Modes) -> CubatureWork {
         CubatureWork {
+            held_d: vec![0.0; 2 * scene.dim * self.held.len()],
+            held_moved: vec![false; self.held.len()],
             d: vec![0.0; self.d0.len()],
             x: modes.point.clone(),
             f: vec![0.0; modes.basis.n],
@@ -106,8 +137,14 @@ impl ReducedForce for Cubature {
         w.x_valid = false;
         w.exact_valid = false;
         match scene.dim {
-            2 => self.project_d::<2>(modes.basis.r, q, w, out),
-            _ => self.project_d::<3>(modes.basis.r, q, w, out),
+            2 => {
+                self.project_d::<2>(modes.basis.r, q, w, out);
+                self.held_d::<2>(modes, q, w, out);
+            }
+            _ => {
+                self.project_d::<3>(modes.basis.r, q, w, out);
+                self.held_d::<3>(modes, q, w, out);
+            }
         }
     }
 
@@ -118,8 +155,6 @@ impl ReducedForce for Cubature {
         }
     }
 
-    /// Held slots other than at rest are refused with a cubature (its
-    /// springs are chosen for one holder); they are written here all the same.
     fn slots_mut<'w>(&self, w: &'w mut CubatureWork) -> &'w mut [f64] {
         &mut w.x
     }
@@ -146,7 +181,19 @@ impl ReducedForce for Cubature {
                     0.5 * wk * (l - l0) * (l - l0)
                 })
                 .sum();
-        self.energy_offset - self.offset.iter().zip(q).map(|(c, q)| c * q).sum::<f64>() + springs
+        let d = scene.dim;
+        let held: f64 = w
+            .held_d
+            .chunks_exact(2 * d)
+            .zip(&self.held)
+            .zip(&w.held_moved)
+            .filter(|(_, moved)| **moved)
+            .map(|((v, h), _)| {
+                let energy = |x: &[f64]| 0.5 * h.k * (x.iter().map(|c| c * c).sum::<f64>().sqrt() - h.l0).powi(2);
+                energy(&v[d..]) - energy(&v[..d])
+            })
+            .sum();
+        self.energy_offset - self.offset.iter().zip(q).map(|(c, q)| c * q).sum::<f64>() + springs + held
     }
 
     fn spring_forces<'w>(&self, scene: &Scene, modes: &Modes, q: &[f64], w: &'w mut CubatureWork) -> &'w [f64] {
@@ -214,12 +261,42 @@ impl Cubature {
         }
     }
 
-    /// kr += sum_S w_e G_e^T K_e(d_e) G_e at the vectors of the last evaluation.
+    /// kr += sum_S w_e G_e^T K_e(d_e) G_e at the vectors of the last
+    /// evaluation, and G_e^T (K_e(moved) - K_e(in place)) G_e of the springs
+    /// at moving holders.
     fn tangent_d<const D: usize>(&self, r: usize, w: &mut CubatureWork, kr: &mut [f64]) {
         let kg = &mut w.kg;
         for ((g, d), (&wk, &l0)) in self.g.chunks_exact(D * r).zip(w.d.chunks_exact(D)).zip(self.wk.iter().zip(&self.l0)) {
             let ke = block::<D>(d.try_into().expect("D values"), wk, l0);
             add_projected_block::<D>(&ke, g, r, kg, kr);
+        }
+        for ((h, v), _) in self.held.iter().zip(w.held_d.chunks_exact(2 * D)).zip(&w.held_moved).filter(|(_, m)| **m) {
+            let change = block::<D>(v[D..].try_into().expect("D values"), h.k, h.l0) - block::<D>(v[..D].try_into().expect("D values"), h.k, h.l0);
+            add_projected_block::<D>(&change, &h.g, r, kg, kr);
+        }
+    }
+
+    /// out += G^T (g(d0 - G q ± δ) - g(d0 - G q)) for every spring at a
+    /// holder that moved (δ its held end's displacement from x*, in the
+    /// slot positions the run placed).
+    fn held_d<const D: usize>(&self, modes: &Modes, q: &[f64], w: &mut CubatureWork, out: &mut [f64]) {
+        let r = modes.basis.r;
+        for ((h, v), moved) in self.held.iter().zip(w.held_d.chunks_exact_mut(2 * D)).zip(w.held_moved.iter_mut()) {
+            let delta: [f64; D] = std::array::from_fn(|i| w.x[h.slot * D + i] - modes.point[h.slot * D + i]);
+            *moved = delta != [0.0; D];
+            if !*moved {
+                continue;
+            }
+            let rest: [f64; D] = std::array::from_fn(|i| h.d0[i] - h.g[i * r..(i + 1) * r].iter().zip(q).map(|(a, b)| a * b).sum::<f64>());
+            let now: [f64; D] = std::array::from_fn(|i| rest[i] + h.sign * delta[i]);
+            v[..D].copy_from_slice(&rest);
+            v[D..].copy_from_slice(&now);
+            let (a, b) = (pull(&now, h.k, h.l0), pull(&rest, h.k, h.l0));
+            for i in 0..D {
+                for (o, gij) in out.iter_mut().zip(&h.g[i * r..(i + 1) * r]) {
+                    *o += gij * (a[i] - b[i]);
+                }
+            }
         }
     }
 }
@@ -286,6 +363,25 @@ fn exact_at_point(scene: &Scene, modes: &Modes, exact: &SpringForces) -> (Vec<f6
     (out, energy)
 }
 
+/// The springs from a free slot to a slot of a holder that moves on its own.
+fn held_springs<const D: usize>(scene: &Scene, modes: &Modes) -> Vec<HeldSpring> {
+    let nf = scene.n_free;
+    let mut moving = vec![false; scene.rest.len() / D];
+    scene.moving_holders().iter().flat_map(|h| &h.slots).for_each(|&s| moving[s] = true);
+    (0..scene.springs.len())
+        .filter_map(|e| {
+            let s = &scene.springs[e];
+            let (slot, sign) = match (s.a < nf, s.b < nf) {
+                (true, false) if moving[s.b] => (s.b, 1.0),
+                (false, true) if moving[s.a] => (s.a, -1.0),
+                _ => return None,
+            };
+            let c = Candidate::<D>::new(scene, modes, e)?;
+            Some(HeldSpring { g: c.g, d0: std::array::from_fn(|i| if i < D { c.d0[i] } else { 0.0 }), k: c.k, l0: c.l0, slot, sign })
+        })
+        .collect()
+}
+
 /// The model of a spring set: each kept spring's G and d0,
 /// c = F0 - sum w p_e(0), and the energy constant U(0) - sum w U_e(0).
 fn assemble<const D: usize>(scene: &Scene, modes: &Modes, set: SpringSet) -> Cubature {
@@ -302,6 +398,7 @@ fn assemble<const D: usize>(scene: &Scene, modes: &Modes, set: SpringSet) -> Cub
         offset,
         energy_offset: energy_at_point,
         exact,
+        held: held_springs::<D>(scene, modes),
         training_error: set.training_error,
         held_out_error: set.held_out_error,
     };
