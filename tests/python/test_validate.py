@@ -79,10 +79,18 @@ INTERFACE = {
     "modeOutOfPlane": ("Float64", "calculatedParameter", "fixed"),
     "modeSymmetry": ("Float64", "calculatedParameter", "fixed"),
     "modeShapes": ("Float64", "calculatedParameter", "fixed"),
+    "nHolders": ("UInt64", "structuralParameter", "fixed"),
+    "holderOfNode": ("UInt64", "parameter", "fixed"),
 }
+# holders 2 to 4: their inputs and the force and torque on them
+for _k in (2, 3, 4):
+    for _c in ("X", "Y", "Z", "RX", "RY", "RZ"):
+        INTERFACE[f"anchor{_k}{_c}"] = ("Float64", "input", "continuous")
+    for _c in ("ForceX", "ForceY", "ForceZ", "TorqueX", "TorqueY", "TorqueZ"):
+        INTERFACE[f"anchor{_k}{_c}"] = ("Float64", "output", "continuous")
 
 ENUMERATIONS = {
-    "fixedNodes": ["top-row", "top-corners"],
+    "fixedNodes": ["top-row", "top-corners", "custom"],
     "reduction": ["modal", "full"],
     "integrator": ["newmark-explicit", "newmark-implicit", "trigonometric"],
     "modeSelection": ["lowest", "load", "trained"],
@@ -101,6 +109,7 @@ DIMENSIONS = {
     "modeOutOfPlane": ["nModes"],
     "modeSymmetry": ["nModes"],
     "modeShapes": ["nModes", "ny", "nx", "dimension"],
+    "holderOfNode": ["ny", "nx"],
 }
 
 
@@ -168,6 +177,7 @@ def test_interface(any_fmu):
         "anchorForceX": "N", "anchorForceY": "N", "anchorForceZ": "N",
         "anchorTorqueX": "N.m", "anchorTorqueY": "N.m", "anchorTorqueZ": "N.m",
         "anchorRX": "rad", "anchorRY": "rad", "anchorRZ": "rad",
+        "anchor2X": "m", "anchor4RZ": "rad", "anchor2ForceY": "N", "anchor3TorqueZ": "N.m",
     }
     defined = {u.name for u in md.unitDefinitions}
     for name, unit in units.items():
