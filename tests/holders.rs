@@ -117,6 +117,18 @@ fn custom_corners_are_the_top_corners_bit_for_bit() {
     }
 }
 
+/// The full space of `grid` and its modal space with every mode kept,
+/// prepared for the holders' motion and turns, lightly damped.
+fn full_and_every_mode(grid: &Grid) -> (Simulator, Simulator) {
+    let dofs = grid.build().unwrap().n_dofs();
+    let mut all = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, dofs);
+    all.anchor_motion = true;
+    all.anchor_rotation = true;
+    let f = Simulator::new(grid.build().unwrap(), &full(), &loads(0, 0.5)).unwrap();
+    let m = Simulator::new(grid.build().unwrap(), &all, &loads(dofs, 0.5)).unwrap();
+    (f, m)
+}
+
 /// The holders' forces add up to the momentum balance, and with every mode
 /// kept the modal space is the full space's to round-off while the
 /// holders move apart and turn.
@@ -124,12 +136,7 @@ fn custom_corners_are_the_top_corners_bit_for_bit() {
 fn every_mode_kept_is_full_space_and_the_forces_add_up() {
     for dim in [2, 3] {
         let grid = corners(5, dim);
-        let dofs = grid.build().unwrap().n_dofs();
-        let mut all = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, dofs);
-        all.anchor_motion = true;
-        all.anchor_rotation = true;
-        let mut f = Simulator::new(grid.build().unwrap(), &full(), &loads(0, 0.5)).unwrap();
-        let mut m = Simulator::new(grid.build().unwrap(), &all, &loads(dofs, 0.5)).unwrap();
+        let (mut f, mut m) = full_and_every_mode(&grid);
         let (mut worst, mut worst_force, mut sum_error) = (0.0f64, 0.0f64, 0.0f64);
         for k in 0..60 {
             let t = 0.01 * k as f64;
@@ -166,12 +173,7 @@ fn four_holders_at_the_corners() {
     let mut grid = Grid { holders: 4, fixed_nodes: FixedNodes::Custom, ..paper(5, 5, 3, FixedNodes::TopRow) };
     grid.holder_of_node = vec![0; 25];
     (grid.holder_of_node[0], grid.holder_of_node[4], grid.holder_of_node[20], grid.holder_of_node[24]) = (1, 2, 3, 4);
-    let dofs = grid.build().unwrap().n_dofs();
-    let mut all = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, dofs);
-    all.anchor_motion = true;
-    all.anchor_rotation = true;
-    let mut f = Simulator::new(grid.build().unwrap(), &full(), &loads(0, 0.5)).unwrap();
-    let mut m = Simulator::new(grid.build().unwrap(), &all, &loads(dofs, 0.5)).unwrap();
+    let (mut f, mut m) = full_and_every_mode(&grid);
     let (mut worst, mut sum_error) = (0.0f64, 0.0f64);
     for k in 0..50 {
         let t = 0.01 * k as f64;
