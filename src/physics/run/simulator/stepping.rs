@@ -53,10 +53,14 @@ impl<S: Readout, I: Scheme> Run<S, I> {
                 h.slots.iter().map(far).fold(0.0, f64::max)
             })
             .collect();
-        let mut holder_nodes = Vec::new();
+        // (holder, node) for every node of a holder that moves on its own, through a slot -> holder map.
+        let mut holder_of_slot = vec![usize::MAX; scene.rest.len() / dim];
         for (j, h) in scene.moving_holders().iter().enumerate() {
-            holder_nodes.extend(scene.slot_of_node.iter().enumerate().filter(|(_, s)| h.slots.contains(s)).map(|(node, _)| (j, node)));
+            h.slots.iter().for_each(|&s| holder_of_slot[s] = j);
         }
+        let mut holder_nodes: Vec<(usize, usize)> =
+            scene.slot_of_node.iter().enumerate().filter(|&(_, &s)| holder_of_slot[s] != usize::MAX).map(|(node, &s)| (holder_of_slot[s], node)).collect();
+        holder_nodes.sort_by_key(|&(j, _)| j);
         let local = turn_loads(loads, &rotation(&state.rotation), dim);
         let mut run = Run {
             outputs: Outputs::new(scene, settings.n_modes),
@@ -139,15 +143,24 @@ impl<S: Readout, I: Scheme> Run<S, I> {
         if u.iter().all(|&c| c == 0.0) {
             return Ok(());
         }
-        let mut dy = vec![0.0; self.state.len()];
-        match (self.space.layout().kept_modes, self.space.modes()) {
-            (Some(_), Some(basis)) => basis.project_displacement(&self.space.scene().dof_mass, &u, &mut dy),
-            _ => dy.copy_from_slice(&u),
-        }
+        let dy = self.coordinates_of(&u);
         for (y, d) in self.state.y.iter_mut().zip(&dy) {
             *y += d;
         }
         Ok(())
+    }
+
+    /// The space's coordinates of a displacement `u` of the free DOFs: its
+    /// modal coordinates Phi^T M u (the part the basis holds), or u itself in full space.
+    fn coordinates_of(&self, u: &[f64]) -> Vec<f64> {
+        match (self.space.layout().kept_modes, self.space.modes()) {
+            (Some(r), Some(basis)) => {
+                let mut q = vec![0.0; r];
+                basis.project_displacement(&self.space.scene().dof_mass, u, &mut q);
+                q
+            }
+            _ => u.to_vec(),
+        }
     }
 
     /// The space the run steps.
@@ -538,14 +551,7 @@ impl<S: Readout, I: Scheme> Steps for Run<S, I> {
         if dy.len() != self.n_dofs() {
             return Err(PhysicsError::SnapshotLength { len: dy.len(), expected: self.n_dofs() });
         }
-        let q = match (self.space.layout().kept_modes, self.space.modes()) {
-            (Some(r), Some(basis)) => {
-                let mut q = vec![0.0; r];
-                basis.project_displacement(&self.space.scene().dof_mass, dy, &mut q);
-                q
-            }
-            _ => dy.to_vec(),
-        };
+        let q = self.coordinates_of(dy);
         self.displace(&q)
     }
 
