@@ -232,7 +232,7 @@ fn every_output_declares_its_dependencies_on_the_point_load() {
         assert!(xml.contains(&want), "{}: {want} not in the model description", v.name);
         outputs += 1;
     }
-    assert_eq!(outputs, 37);
+    assert_eq!(outputs, 40);
 }
 
 #[test]

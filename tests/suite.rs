@@ -16,6 +16,7 @@ mod model_description_xml;
 #[path = "../modelDescription/generate/terminals.rs"]
 mod terminals_and_icons_xml;
 
+mod adaptive;
 mod anchor;
 mod bake;
 mod basis;

@@ -19,11 +19,13 @@ impl Spec {
         let _ = writeln!(r, "pub const LOG_CATEGORIES: &[&str] = &[{}];", cats.join(", "));
         let _ = writeln!(r, "/// Identifies the variable layout in serialized FMU states.");
         let _ = writeln!(r, "pub const LAYOUT_FINGERPRINT: u64 = {:#018x};", self.fingerprint(u32::MAX));
-        let _ = writeln!(r, "/// The variable layout of serialized-state format 5 (the variables without `since_format`).");
-        let _ = writeln!(r, "pub const LAYOUT_FINGERPRINT_FORMAT5: u64 = {:#018x};", self.fingerprint(5));
-        let since: Vec<String> = self.variables.iter().filter(|v| v.since_format.is_some()).map(|v| v.vr.to_string()).collect();
-        let _ = writeln!(r, "/// Value references of the variables serialized-state format 5 lacks.");
-        let _ = writeln!(r, "pub const SINCE_FORMAT6: &[u32] = &[{}];", since.join(", "));
+        let newest = self.variables.iter().filter_map(|v| v.since_format).max().unwrap_or(5);
+        let older: Vec<String> = (5..newest).map(|f| format!("({f}, {:#018x})", self.fingerprint(f))).collect();
+        let _ = writeln!(r, "/// The variable layouts of older serialized-state formats (the variables whose `since_format` is at most the format).");
+        let _ = writeln!(r, "pub const OLDER_LAYOUT_FINGERPRINTS: &[(u32, u64)] = &[{}];", older.join(", "));
+        let since: Vec<String> = self.variables.iter().filter_map(|v| v.since_format.map(|f| format!("({}, {f})", v.vr))).collect();
+        let _ = writeln!(r, "/// Value references of the variables older serialized-state formats lack, with the format that brought each.");
+        let _ = writeln!(r, "pub const SINCE_FORMAT: &[(u32, u32)] = &[{}];", since.join(", "));
         let _ = writeln!(r, "/// Value references.\npub mod vr {{");
         for v in &self.variables {
             let _ = writeln!(r, "    pub const {}: u32 = {};", screaming(&v.name), v.vr);

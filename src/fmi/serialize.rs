@@ -19,7 +19,7 @@ use super::model::Model;
 use super::params::Params;
 use super::state_machine::Mode;
 use super::values::check_value;
-use super::variables::{index_of, LAYOUT_FINGERPRINT, LAYOUT_FINGERPRINT_FORMAT5, SINCE_FORMAT6, VARIABLES};
+use super::variables::{index_of, LAYOUT_FINGERPRINT, OLDER_LAYOUT_FINGERPRINTS, SINCE_FORMAT, VARIABLES};
 use crate::TheModel;
 
 pub const MAGIC: &[u8; 8] = b"MMSFMU3S";
@@ -29,9 +29,11 @@ pub const MAGIC: &[u8; 8] = b"MMSFMU3S";
 /// the anchor's position and rate in the state and its target among the loads;
 /// 5: the holder's orientation and spin, and its target; 6: holders 2 to 4
 /// (their motions in the state, their targets among the loads) and the
-/// variables that set them. Format 5 is still read: its holders 2 to 4 are
-/// at rest and the variables it lacks take their start values.
-pub const VERSION: u32 = 6;
+/// variables that set them; 7: the variables of a later table (those with
+/// `since_format` 7). Formats 5 and 6
+/// are still read: the holders 2 to 4 of format 5 are at rest and the
+/// variables a format lacks take their start values.
+pub const VERSION: u32 = 7;
 /// The oldest format read.
 pub const OLDEST: u32 = 5;
 /// Bytes before the payload.
@@ -106,7 +108,8 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
         return Err(format!("serialized state format {version}, this FMU reads formats {OLDEST} to {VERSION}"));
     }
     let fp = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
-    if fp != if version == VERSION { LAYOUT_FINGERPRINT } else { LAYOUT_FINGERPRINT_FORMAT5 } {
+    let layout = if version == VERSION { Some(LAYOUT_FINGERPRINT) } else { OLDER_LAYOUT_FINGERPRINTS.iter().find(|(f, _)| *f == version).map(|(_, l)| *l) };
+    if layout != Some(fp) {
         return Err("serialized state of a different model description".into());
     }
     let len = u64::from_le_bytes(bytes[20..28].try_into().unwrap());
@@ -148,7 +151,7 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
     for (i, v) in VARIABLES.iter().enumerate() {
         if v.holds_value() {
             if !seen[i] {
-                if version < VERSION && SINCE_FORMAT6.contains(&v.vr) {
+                if SINCE_FORMAT.iter().any(|&(vr, f)| vr == v.vr && f > version) {
                     // Sized below, once the structural parameters are known.
                     params.values[i] = v.start.get(..1).unwrap_or(&[0.0]).to_vec();
                     continue;

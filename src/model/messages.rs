@@ -30,6 +30,7 @@ pub fn variable(q: Quantity) -> &'static str {
         Quantity::TrainingScale => "trainingScale",
         Quantity::TrainingTilt => "trainingTilt",
         Quantity::TrainingTime => "trainingTime",
+        Quantity::ErrorTolerance => "errorTolerance",
         Quantity::Holders => "nHolders",
         Quantity::HolderMotion => "anchor{k}X ... anchor{k}RZ",
     }
@@ -143,6 +144,7 @@ pub fn describe(e: &PhysicsError, p: &Params) -> String {
         Holders(problem) => holders(problem, p),
         SnapshotLength { len, expected } => format!("the state holds {len} values per array, this scene needs {expected}"),
         SnapshotNotFinite => "the state holds non-finite values".into(),
+        AdaptiveState => "reduction = adaptive: a state after the run fell back to full space or grew its basis cannot be restored yet".into(),
     }
 }
 

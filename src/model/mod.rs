@@ -114,6 +114,16 @@ impl Model for MassSpring {
         match built {
             Ok(sim) => {
                 log.log(OK, &format!("simulator set up: {} nodes in {}D, {} modes", sim.scene().n_nodes, sim.scene().dim, sim.mode_frequencies().len()));
+                if sim.settings().reduction == crate::options::Reduction::Adaptive {
+                    log.log(
+                        OK,
+                        &format!(
+                            "reduction = adaptive: a trained basis of {} vectors chosen for errorTolerance = {} (its held-out snapshots' projection error within a quarter of it), exact forces",
+                            sim.reduction_status().basis_size,
+                            sim.settings().error_tolerance
+                        ),
+                    );
+                }
                 self.installed(sim);
                 Ok(())
             }
@@ -184,6 +194,9 @@ impl Model for MassSpring {
             vr::FORCE_RESIDUAL => Computed::Scalar(sim.force_residual()),
             vr::TRAINING_RANGE => Computed::Scalar(sim.training_range()),
             vr::CUBATURE_SPRINGS => Computed::Scalar(sim.cubature_springs() as f64),
+            vr::ERROR_ESTIMATE => Computed::Scalar(sim.reduction_status().error_estimate),
+            vr::REDUCED_FRACTION => Computed::Scalar(sim.reduction_status().reduced_fraction),
+            vr::BASIS_SIZE => Computed::Scalar(sim.reduction_status().basis_size as f64),
             vr::LOAD_NODE_X | vr::LOAD_NODE_Y | vr::LOAD_NODE_Z => Computed::Scalar(component(sim.load_node_position(), (r - vr::LOAD_NODE_X) as usize)),
             vr::LOAD_NODE_V_X | vr::LOAD_NODE_V_Y | vr::LOAD_NODE_V_Z => {
                 Computed::Scalar(component(sim.load_node_velocity(), (r - vr::LOAD_NODE_V_X) as usize))

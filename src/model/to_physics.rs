@@ -71,6 +71,7 @@ impl Params {
             anchor_rotation: self.scalar(vr::ANCHOR_ROTATION) != 0.0,
             force_evaluation: self.enumeration(vr::FORCE_EVALUATION, ForceEvaluation::from_value),
             cubature_tolerance: self.scalar(vr::CUBATURE_TOLERANCE),
+            error_tolerance: self.scalar(vr::ERROR_TOLERANCE),
             max_internal_step: self.scalar(vr::MAX_INTERNAL_STEP),
             substepping: true,
             constraint_modes: true,

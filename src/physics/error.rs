@@ -52,6 +52,7 @@ pub enum Quantity {
     TrainingTilt,
     /// Length of each training run of a trained basis [s].
     TrainingTime,
+    ErrorTolerance,
     /// Number of holders.
     Holders,
     /// A holder's displacement or rotation (holders 2 and on).
@@ -83,6 +84,7 @@ impl Quantity {
             Quantity::TrainingScale => "training range of gravity's magnitude",
             Quantity::TrainingTilt => "training range of gravity's tilt",
             Quantity::TrainingTime => "length of a training run",
+            Quantity::ErrorTolerance => "error tolerance",
             Quantity::Holders => "number of holders",
             Quantity::HolderMotion => "holder displacement or rotation",
         }
@@ -287,6 +289,9 @@ pub enum PhysicsError {
     /// A snapshot holding NaN or infinite values.
     #[error("the snapshot holds non-finite values")]
     SnapshotNotFinite,
+    /// An adaptive run in full space or with a grown basis cannot yet be restored from a snapshot.
+    #[error("an adaptive run that has fallen back to full space or grown its basis cannot be restored from a snapshot")]
+    AdaptiveState,
 }
 
 /// Why the held nodes cannot be given to the holders (holders counted from 1).

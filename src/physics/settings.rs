@@ -42,6 +42,9 @@ pub struct Settings {
     /// With [`ForceEvaluation::Cubature`]: the relative error of Phi^T f on
     /// the training and held-out poses the cubature set is grown to reach.
     pub cubature_tolerance: f64,
+    /// With [`Reduction::Adaptive`]: the error E the run may reach
+    /// (`docs/method.md`, sections 6 and 10).
+    pub error_tolerance: f64,
     /// Upper bound on one internal step [s].
     pub max_internal_step: f64,
     /// Split a communication step into internal steps that keep the
@@ -95,6 +98,7 @@ impl Settings {
             anchor_rotation: start::ANCHOR_ROTATION,
             force_evaluation: start::FORCE_EVALUATION,
             cubature_tolerance: start::CUBATURE_TOLERANCE,
+            error_tolerance: start::ERROR_TOLERANCE,
             max_internal_step: start::MAX_INTERNAL_STEP,
             substepping: true,
             training: TrainingProgram::default(),

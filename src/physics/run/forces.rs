@@ -250,6 +250,7 @@ pub fn add_projected_block<const D: usize>(ke: &SMatrix<f64, D, D>, g: &[f64], r
 /// Sparsity of the free-DOF stiffness matrix, upper triangle, CSC, with the
 /// position of every spring's local entry in the value array precomputed so
 /// numeric assembly is a scatter with no search and no allocation.
+#[derive(Clone, Debug)]
 pub struct StiffnessPattern {
     pub col_ptr: Vec<usize>,
     pub row_idx: Vec<usize>,
@@ -319,16 +320,29 @@ impl StiffnessPattern {
 
     /// Adds `scale` * K(x) (upper triangle) to `vals`.
     pub fn add_tangent(&self, scene: &Scene, x: &[f64], scale: f64, vals: &mut [f64]) {
+        self.add_tangent_with(scene, x, scale, false, vals)
+    }
+
+    /// [`Self::add_tangent`]; with `tension_only` a compressed spring adds
+    /// its axial stiffness alone (its geometric term k (1 - l0/l) (I - u u^T),
+    /// negative in compression, left out), so K(x) stays positive semidefinite.
+    pub fn add_tangent_with(&self, scene: &Scene, x: &[f64], scale: f64, tension_only: bool, vals: &mut [f64]) {
         match scene.dim {
-            2 => self.add_tangent_d::<2>(scene, x, scale, vals),
-            _ => self.add_tangent_d::<3>(scene, x, scale, vals),
+            2 => self.add_tangent_d::<2>(scene, x, scale, tension_only, vals),
+            _ => self.add_tangent_d::<3>(scene, x, scale, tension_only, vals),
         }
     }
 
-    fn add_tangent_d<const D: usize>(&self, scene: &Scene, x: &[f64], scale: f64, vals: &mut [f64]) {
+    fn add_tangent_d<const D: usize>(&self, scene: &Scene, x: &[f64], scale: f64, tension_only: bool, vals: &mut [f64]) {
         let m = 2 * D;
         for (si, s) in scene.springs.iter().enumerate() {
-            let ke = spring_block::<D>(s, x, false);
+            let ke = if tension_only {
+                let d: [f64; D] = std::array::from_fn(|i| x[s.b * D + i] - x[s.a * D + i]);
+                let l = d.iter().map(|c| c * c).sum::<f64>().sqrt();
+                block(&d, s.k, s.rest.min(l))
+            } else {
+                spring_block::<D>(s, x, false)
+            };
             let local = &self.local[si * m * m..(si + 1) * m * m];
             for p in 0..m {
                 for q in 0..m {

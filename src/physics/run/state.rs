@@ -112,6 +112,16 @@ impl State {
     }
 
     /// Copies `other` into `self` without allocating (same lengths).
+    /// Takes the time and the holders' motions of `other`, keeping y, y' and y''.
+    pub fn copy_frame_from(&mut self, other: &State) {
+        self.time = other.time;
+        self.anchor = other.anchor;
+        self.anchor_rate = other.anchor_rate;
+        self.rotation = other.rotation;
+        self.spin = other.spin;
+        self.holders = other.holders;
+    }
+
     pub fn copy_from(&mut self, other: &State) {
         self.time = other.time;
         self.y.copy_from_slice(&other.y);

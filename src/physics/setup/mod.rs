@@ -17,6 +17,7 @@
 //! stages in turn run the run floor's spaces and schemes. No file depends
 //! on one that depends on it (`tests/physics_layers.rs`).
 
+pub mod adaptive_basis;
 pub mod basis;
 pub mod cubature_training;
 pub mod equilibrium;

@@ -31,6 +31,7 @@
 use faer::Mat;
 
 use crate::physics::error::{Expected, PhysicsError, Quantity};
+use crate::physics::run::forces::StiffnessPattern;
 use crate::physics::run::frame::{apply, cross, dot, norm, rotation, Frame};
 use crate::physics::run::holders::{self, Placement};
 use crate::physics::run::integrator::{Buffers, NewmarkExplicit, Scheme};
@@ -264,23 +265,53 @@ pub fn train(scene: Scene, loads: &Loads, settings: &Settings) -> Result<SetupDa
     }
     let (point, pattern, stiffness) = basis::linearize(&scene, loads, settings)?;
     let columns = snapshots(&scene, loads, settings, &point)?;
+    let at = Linearized { point, pattern: &pattern, stiffness: &stiffness };
+    let statics = fixed_vectors(&scene, loads, settings, &at)?;
+    train_on(scene, loads, settings, at, statics, columns)
+}
+
+/// Where a basis is linearized: the point x*, and the stiffness K(x*) on its pattern.
+pub struct Linearized<'a> {
+    pub point: Vec<f64>,
+    pub pattern: &'a StiffnessPattern,
+    pub stiffness: &'a [f64],
+}
+
+/// The vectors a trained basis keeps whatever its snapshots: the static
+/// correction's (with `static_correction`) and the holders' constraint modes.
+pub fn fixed_vectors(scene: &Scene, loads: &Loads, settings: &Settings, at: &Linearized) -> Result<Vec<Vec<f64>>, PhysicsError> {
     let mut statics = if settings.static_correction {
-        let patterns = load_patterns(&scene, loads, settings.anchor_motion, settings.anchor_rotation);
+        let patterns = load_patterns(scene, loads, settings.anchor_motion, settings.anchor_rotation);
         if patterns.is_empty() {
             return Err(PhysicsError::NoLoad);
         }
-        basis::static_vectors(&scene, &pattern, &stiffness, &point, &patterns, settings)?
+        basis::static_vectors(scene, at.pattern, at.stiffness, &at.point, &patterns, settings)?
     } else {
         Vec::new()
     };
-    statics.extend(basis::constraint_vectors(&scene, &pattern, &stiffness, &point, settings)?);
+    statics.extend(basis::constraint_vectors(scene, at.pattern, at.stiffness, &at.point, settings)?);
+    Ok(statics)
+}
+
+/// [`train`] on snapshots `columns` (displacements from `at.point`) already
+/// taken, keeping `statics` (see [`fixed_vectors`]) among the `settings.n_modes` vectors.
+pub fn train_on(
+    scene: Scene,
+    loads: &Loads,
+    settings: &Settings,
+    at: Linearized,
+    statics: Vec<Vec<f64>>,
+    columns: Vec<Vec<f64>>,
+) -> Result<SetupData, PhysicsError> {
+    let r = settings.n_modes;
+    let Linearized { point, pattern, stiffness } = at;
     let p = statics.len().min(r);
     // A few more components than needed stand in for static responses the components already hold.
     let components = principal_components(&scene.dof_mass, &columns, r + p)?;
     let mut vectors: Vec<Vec<f64>> = components[..(r - p).min(components.len())].to_vec();
     vectors.extend(statics);
     vectors.extend(components.iter().skip(r - p).cloned());
-    let modes = basis::orthonormal_ritz(&scene, &pattern, &stiffness, &vectors, r)?;
+    let modes = basis::orthonormal_ritz(&scene, pattern, stiffness, &vectors, r)?;
     let omega_sq_bound = basis_bound(&scene, &modes)?;
     let poses: Vec<Vec<f64>> = columns
         .iter()

@@ -7,6 +7,7 @@
 //! when first asked for after a step and kept until the state changes
 //! (the run's `fresh`).
 
+use super::ReductionStatus;
 use super::{to_node_order, Reads, Run, SetUp, Steps};
 use crate::physics::error::PhysicsError;
 use crate::physics::run::frame::{apply, apply_transposed, cross, dot, ground_velocity, place, rotation};
@@ -339,6 +340,15 @@ impl<S: Readout, I: Scheme> SetUp for Run<S, I> {
 
     fn cubature_springs(&self) -> usize {
         self.space.layout().springs
+    }
+
+    fn reduction_status(&self) -> ReductionStatus {
+        let kept = self.space.layout().kept_modes;
+        ReductionStatus {
+            error_estimate: 0.0,
+            reduced_fraction: if kept.is_some() { 1.0 } else { 0.0 },
+            basis_size: kept.unwrap_or(self.space.scene().n_dofs()),
+        }
     }
 }
 

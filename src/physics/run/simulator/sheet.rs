@@ -132,6 +132,19 @@ pub trait SetUp {
     fn setup_data(&self) -> Option<SetupData>;
     /// Springs one force evaluation visits: every spring, or the cubature set.
     fn cubature_springs(&self) -> usize;
+    /// Where the run stands in its reduction: the estimated error E so far,
+    /// the share of internal steps taken reduced, and the vectors of the
+    /// basis it steps now (the free DOFs in full space). Only an adaptive
+    /// run estimates (`docs/method.md`, section 10); the others report 0, and 1 or 0.
+    fn reduction_status(&self) -> ReductionStatus;
+}
+
+/// See [`SetUp::reduction_status`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReductionStatus {
+    pub error_estimate: f64,
+    pub reduced_fraction: f64,
+    pub basis_size: usize,
 }
 
 /// A run: everything [`super::Simulator`] offers.

@@ -121,7 +121,7 @@ impl<S: Readout, I: Scheme> Run<S, I> {
     }
 
     /// [`Self::place_holders`] at the state.
-    fn place_holders_now(&mut self) {
+    pub(super) fn place_holders_now(&mut self) {
         let (first, others) = (self.first_motion(self.state.anchor_rate, self.state.spin), self.state.holders);
         self.place_holders(&first, &others, 0.0);
     }
@@ -171,7 +171,7 @@ impl<S: Readout, I: Scheme> Run<S, I> {
     /// Evaluates the forces at the state and sets `state.a` as the scheme
     /// needs it (see [`Scheme::settle`]): at the start, and after a change
     /// of loads, which then acts as a step input.
-    fn settle_state(&mut self) {
+    pub(super) fn settle_state(&mut self) {
         I::settle(&self.space, &mut self.work, &mut self.buffers, &mut self.state);
         self.current = true;
     }
@@ -266,7 +266,7 @@ impl<S: Readout, I: Scheme> Run<S, I> {
     }
 
     /// The loads' terms of the space, in the holder's frame once it has turned.
-    fn apply_loads(&mut self) {
+    pub(super) fn apply_loads(&mut self) {
         self.space.apply_loads(&mut self.work);
         if self.turned() {
             let d = self.scene().dim;
@@ -317,7 +317,7 @@ impl<S: Readout, I: Scheme> Run<S, I> {
 
     /// After every change of the state or the loads: the cheap outputs and
     /// the guard's energy now, the costly ones when asked for.
-    fn refresh_outputs(&mut self) {
+    pub(super) fn refresh_outputs(&mut self) {
         self.fresh = Fresh::default();
         let relative = self.space.kinetic_energy(&self.state.v);
         // In the ground's frame: 1/2 (v + c)^T M (v + c), c the anchor's velocity.

@@ -26,6 +26,8 @@ pub struct ModalWork<W> {
     pub(super) kr: Vec<f64>,
     /// F = Phi^T (f + M g) of the last force evaluation, before the weights (for the error indicator).
     pub(super) generalized: Vec<f64>,
+    /// Phi^T f of [`super::Modal::residual_force`].
+    pub(super) generalized_scratch: Vec<f64>,
     /// ||M g + f_p||^2 in the M^-1 norm, the load's scale of the error indicator.
     pub(super) load_scale: f64,
     /// Newton matrix, LU-factored in place, with its row permutation.

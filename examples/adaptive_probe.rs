@@ -1,0 +1,69 @@
+//! The adaptive reduction against full space on cloth N x N (undamped,
+//! explicit, 0.01 s steps, 0.6 s), with gravity set after set-up to the
+//! canonical load, a load inside the training program it never ran, and
+//! two far outside it: E, errorEstimate, the share of steps reduced, the
+//! basis size every 0.1 s, and the run time against full space
+//! (`docs/method.md`, section 10).
+//!
+//! `cargo run --release --example adaptive_probe -- [N] [TOLERANCE]`
+
+use modal_mass_spring::canonical_scenes;
+use modal_mass_spring::physics::*;
+use std::time::Instant;
+const H: f64 = 0.01;
+fn gravity(scale: f64, x_deg: f64, z_deg: f64) -> [f64; 3] {
+    let (a, b) = (x_deg.to_radians(), z_deg.to_radians());
+    let g = [9.81 * b.sin(), -9.81 * b.cos(), 0.0];
+    let g = [g[0], g[1] * a.cos(), g[1] * a.sin()];
+    [scale * g[0], scale * g[1], scale * g[2]]
+}
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let nx: usize = args.get(0).map_or(30, |v| v.parse().unwrap());
+    let tol: f64 = args.get(1).map_or(0.01, |v| v.parse().unwrap());
+    let mut base = canonical_scenes::cloth(nx, nx);
+    base.loads.damping_alpha = 0.0;
+    base.loads.damping_beta = 0.0;
+    let cases =
+        [("canonical", gravity(1.0, 0.0, 0.0)), ("inside", gravity(0.85, 10.0, 10.0)), ("sideways", [9.81, 0.0, 0.0]), ("2g70", gravity(2.0, 70.0, 0.0))];
+    let full = base.with_settings(Settings::new(Reduction::Full, Integrator::NewmarkExplicit, 0));
+    let ad = base.with_settings(Settings { error_tolerance: tol, ..Settings::new(Reduction::Adaptive, Integrator::NewmarkExplicit, 2) });
+    for (name, g) in cases {
+        let mut f = full.simulator().unwrap();
+        let t0 = Instant::now();
+        let mut m = ad.simulator().unwrap();
+        let setup = t0.elapsed().as_secs_f64();
+        let x0 = f.positions().to_vec();
+        for s in [&mut f, &mut m] {
+            let l = Loads { gravity: g, ..s.loads().clone() };
+            s.set_loads(&l).unwrap();
+        }
+        let (mut num, mut den) = (0.0, 0.0);
+        let (mut tf, mut tm) = (0.0, 0.0);
+        for k in 1..=60 {
+            let t = Instant::now();
+            f.do_step(H).unwrap();
+            tf += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            m.do_step(H).unwrap();
+            tm += t.elapsed().as_secs_f64();
+            let (xf, xm) = (f.positions().to_vec(), m.positions().to_vec());
+            num += xf.iter().zip(&xm).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
+            den += xf.iter().zip(&x0).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
+            let st = m.reduction_status();
+            if k % 10 == 0 {
+                println!(
+                    "{name:10} t {:.2} E {:.4} est {:.4} ratio {:.2} reduced {:.3} basis {}",
+                    k as f64 * H,
+                    (num / den).sqrt(),
+                    st.error_estimate,
+                    st.error_estimate / (num / den).sqrt(),
+                    st.reduced_fraction,
+                    st.basis_size
+                );
+            }
+        }
+        println!("internal steps full {} adaptive {}", f.internal_steps_last(), m.internal_steps_last());
+        println!("{name:10} set-up {setup:.2} s, full {tf:.3} s, adaptive {tm:.3} s ({:.1}x)", tf / tm);
+    }
+}

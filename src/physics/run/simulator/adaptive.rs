@@ -1,0 +1,606 @@
+//! The adaptive reduction ([`Reduction::Adaptive`], `docs/method.md`, section 10): a reduced run
+//! and a full-space run of the same scene, one of them stepping, with the
+//! error model between them.
+//!
+//! - Reduced: each communication step is taken in the modal space; the
+//!   error model advances under the residual at the step's end
+//!   ([`crate::physics::run::error_model`]) and the estimate of E counts
+//!   the step. Where the estimated error of the state, relative to how far
+//!   the sheet has moved (at least the motion of its training program),
+//!   would pass the tolerance ([`FALL_BACK`]), the step is undone and
+//!   taken again in full space from the lifted state x = x* + Φ q,
+//!   v = Φ q': the run falls back inside the step.
+//! - Full: the error model holds the error carried from the reduced
+//!   stretch (full space adds none). Every communication step keeps the
+//!   displacement it reached; after a stretch of [`STRETCH`] steps (doubled
+//!   after each return that fails) the directions the stretch saw that the
+//!   basis does not hold join it ([`adaptive_basis`]); if the grown basis
+//!   holds the state and the stretch's last pose to the projection share
+//!   of the tolerance, the run returns to a modal space of the grown basis
+//!   at q = Φᵀ M (x − x*), q' = Φᵀ M v, and the error model takes the part
+//!   of the state the basis leaves out as the error of the return.
+//!
+//! The host's mode weights do not act: the run approximates the physics,
+//! and its basis changes as it grows (as in full space, they act with
+//! the modal reduction only).
+
+use super::{Reads, ReductionStatus, Run, SetUp, Steps};
+use crate::physics::error::{positive, PhysicsError, Quantity};
+use crate::physics::run::error_model::{ErrorModel, ErrorState};
+use crate::physics::run::integrator::Scheme;
+use crate::physics::run::space::{Constants, Full, Modal, Readout, ReducedForce};
+use crate::physics::run::state::{Loads, Snapshot, State};
+use crate::physics::settings::{ModeSelection, Reduction, Settings};
+use crate::physics::setup::adaptive_basis::{self, Chosen, CAP_FACTOR, GROWTH, PROJECTION_SHARE};
+use crate::physics::setup::mode_classes::ModeClasses;
+use crate::physics::setup::modes::ModalBasis;
+use crate::physics::setup::scene::Scene;
+use crate::physics::setup::setup_data::SetupData;
+
+/// The run falls back when the estimated error of the state passes this
+/// share of the tolerance times the distance the sheet has moved (at least
+/// its training program's motion).
+pub const FALL_BACK: f64 = 1.0;
+/// Communication steps of the first stretch in full space before the run tries to return.
+pub const STRETCH: usize = 4;
+/// The longest stretch, in communication steps, and the most poses a stretch keeps.
+pub const LONGEST_STRETCH: usize = 256;
+const KEPT_POSES: usize = 32;
+
+/// What the estimate of E counts: sums over the communication points.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Tally {
+    /// Σ ‖ê_k‖²_M and Σ ‖x_k − x_0‖²_M.
+    pub error_sq: f64,
+    pub motion_sq: f64,
+    /// Internal steps taken reduced, and in all.
+    pub reduced_steps: u64,
+    pub steps: u64,
+}
+
+impl Tally {
+    /// The estimated E of the run so far.
+    pub fn estimate(&self) -> f64 {
+        if self.motion_sq > 0.0 {
+            (self.error_sq / self.motion_sq).sqrt()
+        } else {
+            0.0
+        }
+    }
+
+    /// The share of internal steps taken reduced (1 before the first).
+    pub fn reduced_fraction(&self) -> f64 {
+        if self.steps > 0 {
+            self.reduced_steps as f64 / self.steps as f64
+        } else {
+            1.0
+        }
+    }
+}
+
+/// A reduced run with modal space `Modal<F>` and scheme `R`, its full-space twin with scheme `X`.
+pub struct Adaptive<F: ReducedForce, R: Scheme, X: Scheme> {
+    reduced: Run<Modal<F>, R>,
+    full: Run<Full, X>,
+    in_full: bool,
+    chosen: Chosen,
+    /// The vectors grown so far, oldest first.
+    grown: Vec<Vec<f64>>,
+    model: ErrorModel,
+    error: ErrorState,
+    spare_error: ErrorState,
+    tally: Tally,
+    spare_tally: Tally,
+    residual: Vec<f64>,
+    /// Node positions at the start and each node's mass, for the motion.
+    start: Vec<f64>,
+    node_mass: Vec<f64>,
+    /// The stretch in full space: its poses (displacements from x*), its length and the length it should reach.
+    seen: Vec<Vec<f64>>,
+    stretch: usize,
+    stretch_target: usize,
+    settings: Settings,
+    /// The host's loads, with its mode weights.
+    loads: Loads,
+    spare: Loads,
+    /// The first `settings.n_modes` vectors of the basis (zero columns beyond it), and their coordinates.
+    reported: ModalBasis,
+    frequencies: Vec<f64>,
+    coordinates: Vec<f64>,
+}
+
+fn inner_settings(settings: &Settings, reduction: Reduction, n_modes: usize) -> Settings {
+    Settings { reduction, n_modes, mode_selection: ModeSelection::Trained, ..settings.clone() }
+}
+
+/// `dst` takes every load of `src` but the mode weights.
+fn copy_loads(dst: &mut Loads, src: &Loads) {
+    dst.gravity = src.gravity;
+    dst.point_load = src.point_load;
+    dst.load_node = src.load_node;
+    dst.anchor = src.anchor;
+    dst.rotation = src.rotation;
+    dst.holders = src.holders;
+    dst.damping_alpha = src.damping_alpha;
+    dst.damping_beta = src.damping_beta;
+}
+
+impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
+    /// Set-up: the basis chosen for the tolerance ([`adaptive_basis::choose`]),
+    /// the reduced run on it, the full-space run and the error model.
+    pub fn new(scene: Scene, settings: &Settings, loads: &Loads) -> Result<Self, PhysicsError> {
+        positive(Quantity::ErrorTolerance, settings.error_tolerance)?;
+        let chosen = adaptive_basis::choose(&scene, loads, settings)?;
+        let full_settings = inner_settings(settings, Reduction::Full, 0);
+        let full_loads = Loads { mode_weights: Vec::new(), ..loads.clone() };
+        let full = Run::new(Full::new(scene.clone(), &full_loads, &full_settings)?, &full_settings, &full_loads)?;
+        let reduced = reduced_run(&scene, settings, loads, &chosen.data)?;
+        let model = ErrorModel::new(&scene.dof_mass, chosen.pattern.clone(), chosen.stiffness.clone())?;
+        let n = scene.n_dofs();
+        let node_mass = node_masses(&scene);
+        let mut run = Adaptive {
+            reduced,
+            full,
+            in_full: false,
+            grown: Vec::new(),
+            model,
+            error: ErrorState::zero(n),
+            spare_error: ErrorState::zero(n),
+            tally: Tally::default(),
+            spare_tally: Tally::default(),
+            residual: vec![0.0; n],
+            start: Vec::new(),
+            node_mass,
+            seen: Vec::with_capacity(KEPT_POSES),
+            stretch: 0,
+            stretch_target: STRETCH,
+            settings: settings.clone(),
+            loads: loads.clone(),
+            spare: loads.clone(),
+            reported: ModalBasis { n, r: settings.n_modes, lambda: vec![0.0; settings.n_modes], phi: vec![0.0; n * settings.n_modes] },
+            frequencies: vec![0.0; settings.n_modes],
+            coordinates: vec![0.0; settings.n_modes],
+            chosen,
+        };
+        run.start = run.reduced.positions().to_vec();
+        run.report_basis();
+        run.report_coordinates();
+        Ok(run)
+    }
+
+    fn active(&self) -> &dyn super::Sheet {
+        if self.in_full {
+            &self.full
+        } else {
+            &self.reduced
+        }
+    }
+
+    fn active_mut(&mut self) -> &mut dyn super::Sheet {
+        if self.in_full {
+            &mut self.full
+        } else {
+            &mut self.reduced
+        }
+    }
+
+    /// The first `settings.n_modes` vectors of the current basis, zero beyond it.
+    fn report_basis(&mut self) {
+        let b = self.reduced.space.basis();
+        let (n, k) = (b.n, self.reported.r);
+        self.reported.lambda.fill(0.0);
+        self.reported.phi.fill(0.0);
+        for j in 0..k.min(b.r) {
+            self.reported.lambda[j] = b.lambda[j];
+            for i in 0..n {
+                self.reported.phi[i * k + j] = b.phi[i * b.r + j];
+            }
+        }
+        for (f, l) in self.frequencies.iter_mut().zip(&self.reported.lambda) {
+            *f = l.max(0.0).sqrt();
+        }
+    }
+
+    /// The coordinates of the state in the reported vectors: the reduced
+    /// run's own, or Φᵀ M u of the full-space state.
+    fn report_coordinates(&mut self) {
+        let k = self.coordinates.len();
+        if !self.in_full {
+            let q = self.reduced.modal_coordinates();
+            let m = k.min(q.len());
+            self.coordinates[..m].copy_from_slice(&q[..m]);
+            self.coordinates[m..].fill(0.0);
+            return;
+        }
+        let mass = &self.full.space.scene().dof_mass;
+        let point = &self.chosen.data.point;
+        let u = &self.full.state.y;
+        let rest = &self.full.space.scene().rest;
+        self.coordinates.fill(0.0);
+        for i in 0..u.len() {
+            let mu = mass[i] * (u[i] + rest[i] - point[i]);
+            for (c, p) in self.coordinates.iter_mut().zip(&self.reported.phi[i * k..(i + 1) * k]) {
+                *c += p * mu;
+            }
+        }
+    }
+
+    /// Σ m |x − x0|² over every node at the active run's positions.
+    fn motion_sq(&mut self) -> f64 {
+        let d = self.reduced.space.scene().dim;
+        let x = if self.in_full { self.full.positions() } else { self.reduced.positions() };
+        x.chunks_exact(d)
+            .zip(self.start.chunks_exact(d))
+            .zip(&self.node_mass)
+            .map(|((a, b), m)| m * a.iter().zip(b).map(|(p, q)| (p - q).powi(2)).sum::<f64>())
+            .sum()
+    }
+
+    /// The error model's step over `h` in the reduced run, and the step's count.
+    fn estimate_reduced(&mut self, h: f64) -> Result<(), PhysicsError> {
+        let felt = self.reduced.felt_loads();
+        let q = &self.reduced.state.y;
+        self.reduced.space.residual_force(&felt.gravity, &felt.point_load, q, &mut self.reduced.work, &mut self.residual);
+        self.reduced.current = false;
+        self.model.advance(&mut self.error, h, &self.residual)?;
+        let motion = self.motion_sq();
+        self.tally.error_sq += self.model.norm_sq(&self.error);
+        self.tally.motion_sq += motion;
+        let steps = self.reduced.internal_steps_last as u64;
+        self.tally.reduced_steps += steps;
+        self.tally.steps += steps;
+        Ok(())
+    }
+
+    /// The estimated error of the state has passed its share of the tolerance.
+    fn must_fall_back(&mut self) -> bool {
+        let motion = self.motion_sq().max(self.chosen.motion_scale.powi(2));
+        let error = self.model.norm_sq(&self.error);
+        !(error <= (FALL_BACK * self.settings.error_tolerance).powi(2) * motion)
+    }
+
+    /// The reduced run's state undone to the start of its last step.
+    fn undo_reduced(&mut self) {
+        let backup = self.reduced.backup.clone();
+        self.reduced.resume(&backup, false);
+    }
+
+    /// The full-space run takes the reduced run's state: x = x* + Φ q, v = Φ q'.
+    fn lift(&mut self) {
+        let (u, v) = self.reduced.dof_state();
+        let mut s = self.full.state.clone();
+        self.full.space.rest_coordinates(&mut s.y);
+        for (y, du) in s.y.iter_mut().zip(&u) {
+            *y += du;
+        }
+        s.v.copy_from_slice(&v);
+        s.copy_frame_from(&self.reduced.state);
+        self.full.resume(&s, true);
+        let x = self.full.space.positions(&self.full.state.y, &mut self.full.work).to_vec();
+        self.model.relinearize(self.full.space.scene(), &x);
+        self.in_full = true;
+        self.seen.clear();
+        self.stretch = 0;
+    }
+
+    fn step_full(&mut self, h: f64) -> Result<(), PhysicsError> {
+        self.full.do_step(h)?;
+        // Full space adds no error; the error carried moves on with the linearized dynamics.
+        self.residual.fill(0.0);
+        self.model.advance(&mut self.error, h, &self.residual)?;
+        let motion = self.motion_sq();
+        self.tally.error_sq += self.model.norm_sq(&self.error);
+        self.tally.motion_sq += motion;
+        let steps = self.full.internal_steps_last as u64;
+        self.tally.steps += steps;
+        self.stretch += 1;
+        let pose = self.pose();
+        if self.seen.len() == KEPT_POSES {
+            self.seen.remove(0);
+        }
+        self.seen.push(pose);
+        if self.stretch >= self.stretch_target {
+            self.try_return()?;
+        }
+        Ok(())
+    }
+
+    /// The full-space state's displacement from the linearization point x*.
+    fn pose(&self) -> Vec<f64> {
+        let rest = &self.full.space.scene().rest;
+        self.full.state.y.iter().enumerate().map(|(i, u)| u + rest[i] - self.chosen.data.point[i]).collect()
+    }
+
+    /// Grows the basis from the stretch and returns to it if it holds the
+    /// state; else the next stretch is twice as long (see the module documentation).
+    fn try_return(&mut self) -> Result<(), PhysicsError> {
+        let scene = self.full.space.scene().clone();
+        let size = self.chosen.data.basis.r;
+        let count = ((GROWTH * size as f64).ceil() as usize).max(1);
+        let current = self.reduced.space.basis().clone();
+        let new = adaptive_basis::new_directions(&scene, &current, &self.seen, count)?;
+        let mut grown = self.grown.clone();
+        grown.extend(new);
+        let cap = (CAP_FACTOR * size).min(scene.n_dofs());
+        while self.chosen.trained.len() + grown.len() > cap && !grown.is_empty() {
+            grown.remove(0);
+        }
+        let vectors: Vec<Vec<f64>> = self.chosen.trained.iter().chain(&grown).cloned().collect();
+        let data = adaptive_basis::grown_setup(&scene, &self.chosen, &vectors, &self.settings)?;
+        // The grown basis must hold the state and the stretch's poses.
+        let motion = self.motion_sq().max(self.chosen.motion_scale.powi(2));
+        let limit = (PROJECTION_SHARE * self.settings.error_tolerance).powi(2) * motion;
+        let left = |s: &[f64]| -> f64 {
+            let mut q = vec![0.0; data.basis.r];
+            data.basis.project_displacement(&scene.dof_mass, s, &mut q);
+            (0..s.len())
+                .map(|i| {
+                    scene.dof_mass[i]
+                        * (s[i] - data.basis.phi[i * data.basis.r..(i + 1) * data.basis.r].iter().zip(&q).map(|(p, q)| p * q).sum::<f64>()).powi(2)
+                })
+                .sum()
+        };
+        if !self.seen.iter().all(|s| left(s) <= limit) {
+            self.stretch = 0;
+            self.stretch_target = (2 * self.stretch_target).min(LONGEST_STRETCH);
+            return Ok(());
+        }
+        let mut reduced = reduced_run(&scene, &self.settings, &self.loads, &data)?;
+        // q = Φᵀ M (x − x*), q' = Φᵀ M v; what the basis leaves out is the return's error.
+        let pose = self.pose();
+        let (mass, r) = (&scene.dof_mass, data.basis.r);
+        let mut s = reduced.state.clone();
+        data.basis.project_displacement(mass, &pose, &mut s.y);
+        data.basis.project_displacement(mass, &self.full.state.v, &mut s.v);
+        s.copy_frame_from(&self.full.state);
+        for i in 0..pose.len() {
+            let row = &data.basis.phi[i * r..(i + 1) * r];
+            self.error.e[i] += pose[i] - row.iter().zip(&s.y).map(|(p, q)| p * q).sum::<f64>();
+            self.error.v[i] += self.full.state.v[i] - row.iter().zip(&s.v).map(|(p, q)| p * q).sum::<f64>();
+        }
+        self.error.a.fill(0.0);
+        reduced.resume(&s, true);
+        self.reduced = reduced;
+        self.grown = grown;
+        self.in_full = false;
+        self.stretch = 0;
+        self.report_basis();
+        Ok(())
+    }
+}
+
+/// The modal run of `data` under the host's `loads` (every weight 1).
+fn reduced_run<F: ReducedForce, R: Scheme>(scene: &Scene, settings: &Settings, loads: &Loads, data: &SetupData) -> Result<Run<Modal<F>, R>, PhysicsError> {
+    let r = data.basis.r;
+    let s = inner_settings(settings, Reduction::Modal, r);
+    let l = Loads { mode_weights: vec![1.0; r], ..loads.clone() };
+    Run::new(Modal::<F>::new(scene.clone(), &l, &s, Some(data))?, &s, &l)
+}
+
+/// Each node's mass in output order: a free node's, and for a held node that of the free nodes (the nodes of a grid all weigh the same).
+fn node_masses(scene: &Scene) -> Vec<f64> {
+    let typical = scene.dof_mass.first().copied().unwrap_or(1.0);
+    scene.slot_of_node.iter().map(|&s| if s < scene.n_free { scene.dof_mass[s * scene.dim] } else { typical }).collect()
+}
+
+impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
+    fn max_stable_step(&self) -> f64 {
+        self.active().max_stable_step()
+    }
+
+    fn do_step(&mut self, h: f64) -> Result<(), PhysicsError> {
+        positive(Quantity::StepSize, h)?;
+        if self.in_full {
+            self.step_full(h)?;
+            self.report_coordinates();
+            return Ok(());
+        }
+        self.spare_error.clone_from(&self.error);
+        self.spare_tally = self.tally;
+        self.reduced.do_step(h)?;
+        let estimated = self.estimate_reduced(h);
+        if estimated.is_ok() && !self.must_fall_back() {
+            self.report_coordinates();
+            return Ok(());
+        }
+        // Undone, and taken again in full space from the lifted state.
+        self.error.clone_from(&self.spare_error);
+        self.tally = self.spare_tally;
+        self.undo_reduced();
+        estimated?;
+        self.lift();
+        if let Err(e) = self.step_full(h) {
+            self.in_full = false;
+            return Err(e);
+        }
+        self.report_coordinates();
+        Ok(())
+    }
+
+    fn scene(&self) -> &Scene {
+        self.reduced.scene()
+    }
+
+    fn time(&self) -> f64 {
+        self.active().time()
+    }
+
+    fn n_dofs(&self) -> usize {
+        self.reduced.n_dofs()
+    }
+
+    fn loads(&self) -> &Loads {
+        &self.loads
+    }
+
+    fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    fn internal_steps_last(&self) -> usize {
+        self.active().internal_steps_last()
+    }
+
+    fn edit_loads(&mut self, edit: &mut dyn FnMut(&mut Loads)) -> Result<(), PhysicsError> {
+        self.spare.clone_from(&self.loads);
+        edit(&mut self.loads);
+        let checked = self.loads.validate(self.settings.n_modes).and_then(|()| self.loads.validate_on(self.reduced.scene()));
+        let host = &self.loads;
+        let applied =
+            checked.and_then(|()| self.reduced.edit_loads(&mut |l| copy_loads(l, host))).and_then(|()| self.full.edit_loads(&mut |l| copy_loads(l, host)));
+        if let Err(e) = applied {
+            std::mem::swap(&mut self.loads, &mut self.spare);
+            let host = &self.loads;
+            // Both runs accept the loads they had.
+            let _ = self.reduced.edit_loads(&mut |l| copy_loads(l, host));
+            let _ = self.full.edit_loads(&mut |l| copy_loads(l, host));
+            return Err(e);
+        }
+        Ok(())
+    }
+
+    fn displace(&mut self, dy: &[f64]) -> Result<(), PhysicsError> {
+        self.active_mut().displace(dy)?;
+        self.report_coordinates();
+        Ok(())
+    }
+
+    fn displace_dofs(&mut self, dy: &[f64]) -> Result<(), PhysicsError> {
+        self.active_mut().displace_dofs(dy)?;
+        self.report_coordinates();
+        Ok(())
+    }
+
+    fn snapshot(&self) -> Snapshot {
+        self.active().snapshot()
+    }
+
+    fn restore(&mut self, s: &Snapshot) -> Result<(), PhysicsError> {
+        if self.in_full || !self.grown.is_empty() {
+            return Err(PhysicsError::AdaptiveState);
+        }
+        self.reduced.restore(s)
+    }
+}
+
+impl<F: ReducedForce, R: Scheme, X: Scheme> Reads for Adaptive<F, R, X> {
+    fn positions(&mut self) -> &[f64] {
+        self.active_mut().positions()
+    }
+
+    fn velocities(&mut self) -> &[f64] {
+        self.active_mut().velocities()
+    }
+
+    fn load_node_position(&mut self) -> Option<[f64; 3]> {
+        self.active_mut().load_node_position()
+    }
+
+    fn load_node_velocity(&mut self) -> Option<[f64; 3]> {
+        self.active_mut().load_node_velocity()
+    }
+
+    fn anchor_force(&mut self) -> [f64; 3] {
+        self.active_mut().anchor_force()
+    }
+
+    fn anchor_torque(&mut self) -> [f64; 3] {
+        self.active_mut().anchor_torque()
+    }
+
+    fn holder_force(&mut self, k: usize) -> [f64; 3] {
+        self.active_mut().holder_force(k)
+    }
+
+    fn holder_torque(&mut self, k: usize) -> [f64; 3] {
+        self.active_mut().holder_torque(k)
+    }
+
+    fn kinetic_energy(&self) -> f64 {
+        self.active().kinetic_energy()
+    }
+
+    fn potential_energy(&mut self) -> f64 {
+        self.active_mut().potential_energy()
+    }
+
+    fn force_residual(&mut self) -> f64 {
+        self.active_mut().force_residual()
+    }
+
+    fn modal_coordinates(&self) -> &[f64] {
+        &self.coordinates
+    }
+
+    fn spring_force(&mut self, y: &[f64]) -> Result<Vec<f64>, PhysicsError> {
+        self.active_mut().spring_force(y)
+    }
+
+    fn training_range(&self) -> f64 {
+        self.active().training_range()
+    }
+}
+
+impl<F: ReducedForce, R: Scheme, X: Scheme> SetUp for Adaptive<F, R, X> {
+    fn mode_frequencies(&self) -> &[f64] {
+        &self.frequencies
+    }
+
+    fn mode_shapes(&self) -> Option<&ModalBasis> {
+        Some(&self.reported)
+    }
+
+    fn mode_classes(&self) -> ModeClasses {
+        let mut c = self.reduced.mode_classes();
+        c.out_of_plane.resize(self.reported.r, 0.0);
+        c.symmetry.resize(self.reported.r, 0.0);
+        c
+    }
+
+    fn mode_grid_shapes(&self) -> Vec<f64> {
+        crate::physics::setup::mode_classes::grid_shapes(self.reduced.scene(), &self.reported)
+    }
+
+    fn setup_data(&self) -> Option<SetupData> {
+        None
+    }
+
+    fn cubature_springs(&self) -> usize {
+        self.active().cubature_springs()
+    }
+
+    fn reduction_status(&self) -> ReductionStatus {
+        ReductionStatus {
+            error_estimate: self.tally.estimate(),
+            reduced_fraction: self.tally.reduced_fraction(),
+            basis_size: if self.in_full { self.reduced.n_dofs() } else { self.reduced.space.basis().r },
+        }
+    }
+}
+
+impl<S: Readout, I: Scheme> Run<S, I> {
+    /// The free DOFs' displacement from rest and velocity in the holder's frame.
+    fn dof_state(&mut self) -> (Vec<f64>, Vec<f64>) {
+        let n = self.space.scene().n_dofs();
+        let x = self.space.positions(&self.state.y, &mut self.work);
+        let rest = &self.space.scene().rest;
+        let u = (0..n).map(|k| x[k] - rest[k]).collect();
+        let mut v = vec![0.0; n];
+        self.space.dof_velocities(&self.state.v, &mut v);
+        (u, v)
+    }
+
+    /// Continues from `s` under the run's loads: its accelerations made
+    /// those of the state with `settle` (a state from elsewhere), kept otherwise (a state of this run).
+    fn resume(&mut self, s: &State, settle: bool) {
+        self.state.copy_from(s);
+        self.apply_loads();
+        self.place_holders_now();
+        if settle {
+            self.settle_state();
+        } else {
+            self.evaluate_forces();
+        }
+        self.refresh_outputs();
+    }
+}

@@ -1,0 +1,169 @@
+//! The adaptive reduction at set-up and on each return from full space
+//! (`docs/method.md`, section 10): the basis sized for the error tolerance,
+//! and the basis grown from what a full-space stretch saw.
+//!
+//! **Size.** The training program's snapshots d_k (displacements from the
+//! linearization point x*, [`trained_basis::snapshots`]) are split by sample:
+//! the even ones train, the odd ones are held out. With c_j the first j
+//! mass-weighted principal components of the even ones (M-orthonormal),
+//! the held-out projection error of j components is
+//!
+//! ```text
+//! P(j) = sqrt( Σ_k ‖d_k − Σ_{i≤j} c_i c_iᵀ M d_k‖²_M / Σ_k ‖d_k‖²_M ),   k odd,
+//! ```
+//!
+//! the part of the held-out motion j components cannot hold, measured as
+//! E is. The basis keeps the fewest components with P(j) ≤
+//! [`PROJECTION_SHARE`] × tolerance (the rest of the tolerance is left to
+//! the dynamics: a basis that holds every pose to P still moves between
+//! them with an error), plus the vectors a trained basis always keeps
+//! ([`trained_basis::fixed_vectors`]), and is trained on every snapshot as
+//! a trained basis is ([`trained_basis::train_on`]).
+//!
+//! **Growth.** After a stretch in full space, the stretch's displacements
+//! less their part in the basis, s_k − Φ Φᵀ M s_k, give their principal
+//! components; the largest [`GROWTH`] of them (at least one) join the
+//! basis, which is M-orthonormalized and diagonalized again
+//! ([`basis::orthonormal_ritz`]). The trained vectors always stay; the
+//! vectors grown stay while the basis holds at most [`CAP_FACTOR`] times
+//! the size chosen at set-up, the oldest dropped first.
+
+use crate::physics::error::PhysicsError;
+use crate::physics::run::forces::StiffnessPattern;
+use crate::physics::run::space::basis_bound;
+use crate::physics::run::state::Loads;
+use crate::physics::settings::{Linearization, ModeSelection, Settings};
+use crate::physics::setup::basis;
+use crate::physics::setup::modes::ModalBasis;
+use crate::physics::setup::scene::Scene;
+use crate::physics::setup::setup_data::SetupData;
+use crate::physics::setup::trained_basis::{self, principal_components, Linearized};
+
+/// Share of the tolerance the held-out projection error may take.
+pub const PROJECTION_SHARE: f64 = 0.25;
+/// The basis may grow to this many times its size at set-up.
+pub const CAP_FACTOR: usize = 2;
+/// Share of the set-up size one return from full space may add (at least one vector).
+pub const GROWTH: f64 = 0.25;
+
+/// What set-up chose for an adaptive run.
+pub struct Chosen {
+    /// The trained basis (and its cubature, if asked for).
+    pub data: SetupData,
+    /// Principal components kept, and the held-out projection error they reach.
+    pub components: usize,
+    pub held_out_error: f64,
+    /// The fewest components would reach the tolerance's share only with
+    /// more than the snapshots hold: the basis holds every component.
+    pub short: bool,
+    /// sqrt of the mean of ‖d_k‖²_M over the snapshots: how far the scene
+    /// moves under its program [m sqrt(kg)].
+    pub motion_scale: f64,
+    /// The stiffness at the linearization point, for the error model.
+    pub pattern: StiffnessPattern,
+    pub stiffness: Vec<f64>,
+    /// The basis vectors of the trained set-up, as columns (kept through every growth).
+    pub trained: Vec<Vec<f64>>,
+}
+
+/// The held-out projection error P(j) for j = 0 ..= components of `train` (see the module documentation).
+pub fn held_out_errors(mass: &[f64], train: &[Vec<f64>], held_out: &[Vec<f64>], components: usize) -> Result<Vec<f64>, PhysicsError> {
+    let c = principal_components(mass, train, components)?;
+    let total: f64 = held_out.iter().map(|d| m_dot(mass, d, d)).sum();
+    let mut left = total;
+    let mut errors = vec![ratio(left, total)];
+    for cj in &c {
+        left -= held_out.iter().map(|d| m_dot(mass, cj, d).powi(2)).sum::<f64>();
+        errors.push(ratio(left.max(0.0), total));
+    }
+    Ok(errors)
+}
+
+fn ratio(part: f64, total: f64) -> f64 {
+    if total > 0.0 {
+        (part / total).sqrt()
+    } else {
+        0.0
+    }
+}
+
+/// uᵀ M v.
+pub fn m_dot(mass: &[f64], u: &[f64], v: &[f64]) -> f64 {
+    mass.iter().zip(u).zip(v).map(|((m, a), b)| m * a * b).sum()
+}
+
+/// The set-up of an adaptive run on `scene` under the set-up `loads` (see the module documentation).
+pub fn choose(scene: &Scene, loads: &Loads, settings: &Settings) -> Result<Chosen, PhysicsError> {
+    let n = scene.n_dofs();
+    let trained_settings = Settings { mode_selection: ModeSelection::Trained, ..settings.clone() };
+    let (point, pattern, stiffness) = basis::linearize(scene, loads, &trained_settings)?;
+    let columns = trained_basis::snapshots(scene, loads, &trained_settings, &point)?;
+    let (even, odd): (Vec<Vec<f64>>, Vec<Vec<f64>>) = {
+        let (e, o): (Vec<_>, Vec<_>) = columns.iter().enumerate().partition(|(k, _)| k % 2 == 0);
+        (e.into_iter().map(|(_, c)| c.clone()).collect(), o.into_iter().map(|(_, c)| c.clone()).collect())
+    };
+    let most = even.len().min(n);
+    let errors = held_out_errors(&scene.dof_mass, &even, &odd, most)?;
+    drop((even, odd));
+    let target = PROJECTION_SHARE * settings.error_tolerance;
+    let found = errors.iter().position(|&e| e <= target);
+    let components = found.unwrap_or(errors.len() - 1).max(1);
+    let motion_scale = (columns.iter().map(|d| m_dot(&scene.dof_mass, d, d)).sum::<f64>() / columns.len().max(1) as f64).sqrt();
+    let at = Linearized { point, pattern: &pattern, stiffness: &stiffness };
+    let statics = trained_basis::fixed_vectors(scene, loads, &trained_settings, &at)?;
+    let size = (components + statics.len()).min(n);
+    let sized = Settings { n_modes: size, ..trained_settings };
+    let data = trained_basis::train_on(scene.clone(), loads, &sized, at, statics, columns)?;
+    let trained = columns_of(&data.basis);
+    Ok(Chosen { held_out_error: errors[components.min(errors.len() - 1)], components, short: found.is_none(), motion_scale, data, pattern, stiffness, trained })
+}
+
+/// The columns of a basis (row-major n x r) as vectors.
+pub fn columns_of(b: &ModalBasis) -> Vec<Vec<f64>> {
+    (0..b.r).map(|j| (0..b.n).map(|i| b.phi[i * b.r + j]).collect()).collect()
+}
+
+/// The directions a stretch in full space saw that `current` does not
+/// hold: the largest `count` principal components of the stretch's
+/// displacements `seen` (from the linearization point) less their part in
+/// `current`, those above 1e-6 of the largest displacement seen.
+pub fn new_directions(scene: &Scene, current: &ModalBasis, seen: &[Vec<f64>], count: usize) -> Result<Vec<Vec<f64>>, PhysicsError> {
+    let mass = &scene.dof_mass;
+    let mut q = vec![0.0; current.r];
+    let rests: Vec<Vec<f64>> = seen
+        .iter()
+        .map(|s| {
+            current.project_displacement(mass, s, &mut q);
+            let mut rest = s.clone();
+            for (i, ri) in rest.iter_mut().enumerate() {
+                *ri -= current.phi[i * current.r..(i + 1) * current.r].iter().zip(&q).map(|(p, q)| p * q).sum::<f64>();
+            }
+            rest
+        })
+        .collect();
+    let largest = seen.iter().map(|s| m_dot(mass, s, s)).fold(0.0, f64::max).sqrt();
+    let biggest_rest = rests.iter().map(|s| m_dot(mass, s, s)).fold(0.0, f64::max).sqrt();
+    if !(biggest_rest > 1e-6 * largest) {
+        return Ok(Vec::new());
+    }
+    principal_components(mass, &rests, count)
+}
+
+/// The basis of `vectors` (trained first, then grown), M-orthonormalized
+/// and diagonalized with the stiffness at the linearization point, as the
+/// data a modal space is built from.
+pub fn grown_setup(scene: &Scene, chosen: &Chosen, vectors: &[Vec<f64>], settings: &Settings) -> Result<SetupData, PhysicsError> {
+    let modes = match basis::orthonormal_ritz(scene, &chosen.pattern, &chosen.stiffness, vectors, vectors.len()) {
+        Err(PhysicsError::BasisDeficient { found, .. }) if found > 0 => basis::orthonormal_ritz(scene, &chosen.pattern, &chosen.stiffness, vectors, found)?,
+        other => other?,
+    };
+    let omega_sq_bound = basis_bound(scene, &modes)?;
+    Ok(SetupData {
+        basis: modes,
+        point: chosen.data.point.clone(),
+        at_rest: settings.linearization == Linearization::Rest,
+        omega_sq_bound,
+        cubature: None,
+        range: None,
+    })
+}
