@@ -137,7 +137,7 @@ def test_enumerations_select_the_model(new_instance):
     assert not np.array_equal(runs[(1, 1)], runs[(1, 2)])
     assert not np.array_equal(runs[(1, 1)], runs[(1, 3)])
     with pytest.raises(FMICallException):
-        new_instance().slave.setInt64([inst.vr["reduction"]], [3])
+        new_instance().slave.setInt64([inst.vr["reduction"]], [4])
     # the trigonometric integrator needs the modal space: refused at set-up, naming both variables
     inst = new_instance("r2i3")
     inst.slave.setInt64([inst.vr["reduction"], inst.vr["integrator"]], [2, 3])

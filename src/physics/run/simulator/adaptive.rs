@@ -6,17 +6,19 @@
 //!   error model advances under the residual at the step's end
 //!   ([`crate::physics::run::error_model`]) and the estimate of E counts
 //!   the step. Where the estimated error of the state, relative to how far
-//!   the sheet has moved (at least the motion of its training program),
-//!   would pass the tolerance ([`FALL_BACK`]), the step is undone and
-//!   taken again in full space from the lifted state x = x* + Φ q,
-//!   v = Φ q': the run falls back inside the step.
+//!   the sheet has moved (at least the RMS motion of its training program),
+//!   passes [`FALL_BACK`] times the tolerance, the step is undone and taken
+//!   again in full space from the lifted state x = x* + Φ q, v = Φ q': the
+//!   run falls back inside the step. Loads outside the training program
+//!   (gravity scaled or turned beyond it, a point load it did not run)
+//!   fall back before the step: the basis was not trained for them.
 //! - Full: the error model holds the error carried from the reduced
 //!   stretch (full space adds none). Every communication step keeps the
 //!   displacement it reached; after a stretch of [`STRETCH`] steps (doubled
 //!   after each return that fails) the directions the stretch saw that the
 //!   basis does not hold join it ([`adaptive_basis`]); if the grown basis
-//!   holds the state and the stretch's last pose to the projection share
-//!   of the tolerance, the run returns to a modal space of the grown basis
+//!   holds the stretch's poses and the state's velocity to the projection
+//!   share of the tolerance (and the loads are back in the program), the run returns to a modal space of the grown basis
 //!   at q = Φᵀ M (x − x*), q' = Φᵀ M v, and the error model takes the part
 //!   of the state the basis leaves out as the error of the return.
 //!
@@ -27,6 +29,7 @@
 use super::{Reads, ReductionStatus, Run, SetUp, Steps};
 use crate::physics::error::{positive, PhysicsError, Quantity};
 use crate::physics::run::error_model::{ErrorModel, ErrorState};
+use crate::physics::run::frame::dot;
 use crate::physics::run::integrator::Scheme;
 use crate::physics::run::space::{Constants, Full, Modal, Readout, ReducedForce};
 use crate::physics::run::state::{Loads, Snapshot, State};
@@ -40,7 +43,7 @@ use crate::physics::setup::setup_data::SetupData;
 /// The run falls back when the estimated error of the state passes this
 /// share of the tolerance times the distance the sheet has moved (at least
 /// its training program's motion).
-pub const FALL_BACK: f64 = 1.0;
+pub const FALL_BACK: f64 = 0.4;
 /// Communication steps of the first stretch in full space before the run tries to return.
 pub const STRETCH: usize = 4;
 /// The longest stretch, in communication steps, and the most poses a stretch keeps.
@@ -100,6 +103,9 @@ pub struct Adaptive<F: ReducedForce, R: Scheme, X: Scheme> {
     stretch: usize,
     stretch_target: usize,
     settings: Settings,
+    /// Gravity and the point load at set-up, about which the training program varies them.
+    setup_gravity: [f64; 3],
+    setup_point_load: [f64; 3],
     /// The host's loads, with its mode weights.
     loads: Loads,
     spare: Loads,
@@ -155,6 +161,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             stretch: 0,
             stretch_target: STRETCH,
             settings: settings.clone(),
+            setup_gravity: loads.gravity,
+            setup_point_load: if loads.load_node.is_some() { loads.point_load } else { [0.0; 3] },
             loads: loads.clone(),
             spare: loads.clone(),
             reported: ModalBasis { n, r: settings.n_modes, lambda: vec![0.0; settings.n_modes], phi: vec![0.0; n * settings.n_modes] },
@@ -242,6 +250,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         let q = &self.reduced.state.y;
         self.reduced.space.residual_force(&felt.gravity, &felt.point_load, q, &mut self.reduced.work, &mut self.residual);
         self.reduced.current = false;
+        let x = self.reduced.space.positions(&self.reduced.state.y, &mut self.reduced.work);
+        self.model.relinearize(self.reduced.space.scene(), x);
         self.model.advance(&mut self.error, h, &self.residual)?;
         let motion = self.motion_sq();
         self.tally.error_sq += self.model.norm_sq(&self.error);
@@ -250,6 +260,38 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         self.tally.reduced_steps += steps;
         self.tally.steps += steps;
         Ok(())
+    }
+
+    /// The loads are outside the training program the basis was trained
+    /// on: gravity scaled beyond 1 ± trainingScale of the set-up gravity or
+    /// turned from it by more than trainingTilt, or a point load the
+    /// program did not run (one where set-up had none; one turned from the
+    /// set-up's or larger than 1 + trainingScale times it), with a
+    /// hundredth of slack for round-off.
+    fn outside_program(&self) -> bool {
+        let t = &self.settings.training;
+        let slack = 0.01;
+        let angle = |a: &[f64; 3], b: &[f64; 3]| -> f64 {
+            let n = (dot(a, a) * dot(b, b)).sqrt();
+            if n > 0.0 {
+                (dot(a, b) / n).clamp(-1.0, 1.0).acos()
+            } else {
+                0.0
+            }
+        };
+        let (g0, g) = (&self.setup_gravity, &self.loads.gravity);
+        let n0 = dot(g0, g0).sqrt();
+        if n0 > 0.0 {
+            let scale = dot(g, g).sqrt() / n0;
+            if scale < (1.0 - t.scale) * (1.0 - slack) || scale > (1.0 + t.scale) * (1.0 + slack) || angle(g0, g) > t.tilt * (1.0 + slack) + 1e-9 {
+                return true;
+            }
+        }
+        let d = self.reduced.space.scene().dim;
+        let planar = |p: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| if i < d { p[i] } else { 0.0 }) };
+        let (p0, p) = (planar(&self.setup_point_load), planar(&self.loads.point_load));
+        let (m0, m) = (dot(&p0, &p0).sqrt(), dot(&p, &p).sqrt());
+        m > 0.0 && (m0 == 0.0 || m > (1.0 + t.scale) * (1.0 + slack) * m0 || angle(&p0, &p) > 1e-6)
     }
 
     /// The estimated error of the state has passed its share of the tolerance.
@@ -276,8 +318,6 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         s.v.copy_from_slice(&v);
         s.copy_frame_from(&self.reduced.state);
         self.full.resume(&s, true);
-        let x = self.full.space.positions(&self.full.state.y, &mut self.full.work).to_vec();
-        self.model.relinearize(self.full.space.scene(), &x);
         self.in_full = true;
         self.seen.clear();
         self.stretch = 0;
@@ -287,6 +327,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         self.full.do_step(h)?;
         // Full space adds no error; the error carried moves on with the linearized dynamics.
         self.residual.fill(0.0);
+        let x = self.full.space.positions(&self.full.state.y, &mut self.full.work);
+        self.model.relinearize(self.full.space.scene(), x);
         self.model.advance(&mut self.error, h, &self.residual)?;
         let motion = self.motion_sq();
         self.tally.error_sq += self.model.norm_sq(&self.error);
@@ -314,6 +356,10 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// Grows the basis from the stretch and returns to it if it holds the
     /// state; else the next stretch is twice as long (see the module documentation).
     fn try_return(&mut self) -> Result<(), PhysicsError> {
+        if self.outside_program() {
+            self.stretch = 0;
+            return Ok(());
+        }
         let scene = self.full.space.scene().clone();
         let size = self.chosen.data.basis.r;
         let count = ((GROWTH * size as f64).ceil() as usize).max(1);
@@ -340,7 +386,11 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
                 })
                 .sum()
         };
-        if !self.seen.iter().all(|s| left(s) <= limit) {
+        // And the state's velocity, to the same share of its own size.
+        let v = &self.full.state.v;
+        let speed: f64 = (0..v.len()).map(|i| scene.dof_mass[i] * v[i] * v[i]).sum();
+        let holds_velocity = left(v) <= (PROJECTION_SHARE * self.settings.error_tolerance).powi(2) * speed;
+        if !holds_velocity || !self.seen.iter().all(|s| left(s) <= limit) {
             self.stretch = 0;
             self.stretch_target = (2 * self.stretch_target).min(LONGEST_STRETCH);
             return Ok(());
@@ -394,6 +444,11 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
             self.step_full(h)?;
             self.report_coordinates();
             return Ok(());
+        }
+        if self.outside_program() {
+            // A basis trained for other loads: full space from the start of the step.
+            self.lift();
+            return self.step_full(h).inspect(|_| self.report_coordinates());
         }
         self.spare_error.clone_from(&self.error);
         self.spare_tally = self.tally;
