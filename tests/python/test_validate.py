@@ -95,7 +95,7 @@ for _k in (2, 3, 4):
 
 ENUMERATIONS = {
     "fixedNodes": ["top-row", "top-corners", "custom"],
-    "reduction": ["modal", "full"],
+    "reduction": ["modal", "full", "adaptive"],
     "integrator": ["newmark-explicit", "newmark-implicit", "trigonometric"],
     "modeSelection": ["lowest", "load", "trained"],
     "linearization": ["rest", "equilibrium"],

@@ -263,10 +263,10 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     }
 
     /// The loads are outside the training program the basis was trained
-    /// on: gravity scaled beyond 1 ± trainingScale of the set-up gravity or
-    /// turned from it by more than trainingTilt, or a point load the
+    /// on: gravity scaled beyond 1 ± the program's scale s of the set-up
+    /// gravity or turned from it by more than its tilt, or a point load the
     /// program did not run (one where set-up had none; one turned from the
-    /// set-up's or larger than 1 + trainingScale times it), with a
+    /// set-up's or larger than 1 + s times it), with a
     /// hundredth of slack for round-off.
     fn outside_program(&self) -> bool {
         let t = &self.settings.training;
