@@ -28,8 +28,8 @@ fn do_step_allocates_nothing() {
         (ModeSelection::Trained, false, Rest, Cubature),
     ];
     for name in ["paper-2d-top-row", "paper-3d-sheet"] {
-        // reduction = adaptive builds a full-space state when it falls back and a
-        // modal space when it returns; its steps between those are not yet checked here.
+        // reduction = adaptive builds a modal space when it returns from full
+        // space: its steps in each mode are checked below.
         for &reduction in Reduction::ALL.iter().filter(|&&r| r != Reduction::Adaptive) {
             for &integrator in Integrator::ALL {
                 for &(mode_selection, static_correction, linearization, force_evaluation) in
@@ -85,5 +85,43 @@ fn do_step_allocates_nothing() {
                 }
             }
         }
+    }
+}
+
+/// An adaptive run's steps allocate nothing, reduced (estimates included)
+/// and in full space (a fall-back included); only a return, which builds a
+/// modal space for the grown basis, does.
+#[test]
+fn adaptive_steps_allocate_nothing() {
+    for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit, Integrator::Trigonometric] {
+        let mut setup = canonical_scenes::canonical("paper-2d-top-row").unwrap().with_settings(Settings::new(Reduction::Adaptive, integrator, 4));
+        setup.loads.damping_beta = 1e-3;
+        let mut sim = setup.simulator().unwrap_or_else(|e| panic!("{integrator:?}: {e}"));
+        sim.do_step(0.01).unwrap();
+        let mut loads = sim.loads().clone();
+        let read = |sim: &mut Simulator| {
+            let x = sim.positions()[0] + sim.velocities()[0] + sim.potential_energy() + sim.force_residual() + sim.anchor_force()[1];
+            let s = sim.reduction_status();
+            assert!((x + s.error_estimate + s.reduced_fraction).is_finite());
+        };
+        let n = allocations(|| {
+            for _ in 0..40 {
+                sim.do_step(0.01).unwrap();
+                read(&mut sim);
+            }
+        });
+        assert_eq!(sim.reduction_status().reduced_fraction, 1.0, "{integrator:?}: the program's own load stays reduced");
+        assert_eq!(n, 0, "{integrator:?}: {n} allocations in 40 reduced steps");
+        // Twice gravity, outside the program: full space from the next step on, with no return.
+        loads.gravity = [0.0, -19.62, 0.0];
+        let n = allocations(|| {
+            sim.set_loads(&loads).unwrap();
+            for _ in 0..40 {
+                sim.do_step(0.01).unwrap();
+                read(&mut sim);
+            }
+        });
+        assert!(sim.reduction_status().reduced_fraction < 1.0, "{integrator:?}: fell back");
+        assert_eq!(n, 0, "{integrator:?}: {n} allocations in a fall-back and 40 full-space steps");
     }
 }

@@ -63,6 +63,13 @@ impl ErrorState {
         ErrorState { e: vec![0.0; n], v: vec![0.0; n], a: vec![0.0; n] }
     }
 
+    /// Takes `other`'s values without allocating (the derived `clone_from` would).
+    pub fn copy_from(&mut self, other: &ErrorState) {
+        self.e.copy_from_slice(&other.e);
+        self.v.copy_from_slice(&other.v);
+        self.a.copy_from_slice(&other.a);
+    }
+
     pub fn is_finite(&self) -> bool {
         self.e.iter().chain(&self.v).chain(&self.a).all(|x| x.is_finite())
     }

@@ -32,8 +32,9 @@ use crate::physics::error::PhysicsError;
 use crate::physics::run::forces::StiffnessPattern;
 use crate::physics::run::space::basis_bound;
 use crate::physics::run::state::Loads;
-use crate::physics::settings::{Linearization, ModeSelection, Settings};
+use crate::physics::settings::{ForceEvaluation, Linearization, ModeSelection, Settings};
 use crate::physics::setup::basis;
+use crate::physics::setup::cubature_training::{self, MAX_MODES as MAX_CUBATURE_MODES};
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
 use crate::physics::setup::setup_data::SetupData;
@@ -64,7 +65,14 @@ pub struct Chosen {
     pub stiffness: Vec<f64>,
     /// The basis vectors of the trained set-up, as columns (kept through every growth).
     pub trained: Vec<Vec<f64>>,
+    /// The training snapshots' coordinates in the trained basis (the cubature's poses on a return).
+    pub poses: Vec<Vec<f64>>,
+    /// The settings of the trained basis: its size, force model and cubature tolerance.
+    pub settings: Settings,
 }
+
+/// With cubature forces asked for, they are used when the scene has at least this many springs per basis vector.
+pub const CUBATURE_SPRINGS_PER_VECTOR: usize = 20;
 
 /// The held-out projection error P(j) for j = 0 ..= components of `train` (see the module documentation).
 pub fn held_out_errors(mass: &[f64], train: &[Vec<f64>], held_out: &[Vec<f64>], components: usize) -> Result<Vec<f64>, PhysicsError> {
@@ -112,10 +120,39 @@ pub fn choose(scene: &Scene, loads: &Loads, settings: &Settings) -> Result<Chose
     let at = Linearized { point, pattern: &pattern, stiffness: &stiffness };
     let statics = trained_basis::fixed_vectors(scene, loads, &trained_settings, &at)?;
     let size = (components + statics.len()).min(n);
-    let sized = Settings { n_modes: size, ..trained_settings };
-    let data = trained_basis::train_on(scene.clone(), loads, &sized, at, statics, columns)?;
+    // Cubature forces when asked for and they visit far fewer springs than every one, at the tolerance's accuracy.
+    let cubature = settings.force_evaluation == ForceEvaluation::Cubature
+        && scene.springs.len() >= CUBATURE_SPRINGS_PER_VECTOR * size
+        && CAP_FACTOR * size <= MAX_CUBATURE_MODES;
+    let sized = Settings {
+        n_modes: size,
+        force_evaluation: if cubature { ForceEvaluation::Cubature } else { ForceEvaluation::Exact },
+        cubature_tolerance: settings.error_tolerance.min(1.0),
+        ..trained_settings
+    };
+    let data = trained_basis::train_on(scene.clone(), loads, &sized, at, statics, &columns)?;
+    let poses = columns
+        .iter()
+        .map(|d| {
+            let mut q = vec![0.0; data.basis.r];
+            data.basis.project_displacement(&scene.dof_mass, d, &mut q);
+            q
+        })
+        .collect();
+    drop(columns);
     let trained = columns_of(&data.basis);
-    Ok(Chosen { held_out_error: errors[components.min(errors.len() - 1)], components, short: found.is_none(), motion_scale, data, pattern, stiffness, trained })
+    Ok(Chosen {
+        held_out_error: errors[components.min(errors.len() - 1)],
+        components,
+        short: found.is_none(),
+        motion_scale,
+        data,
+        pattern,
+        stiffness,
+        trained,
+        poses,
+        settings: sized,
+    })
 }
 
 /// The columns of a basis (row-major n x r) as vectors.
@@ -151,19 +188,41 @@ pub fn new_directions(scene: &Scene, current: &ModalBasis, seen: &[Vec<f64>], co
 
 /// The basis of `vectors` (trained first, then grown), M-orthonormalized
 /// and diagonalized with the stiffness at the linearization point, as the
-/// data a modal space is built from.
-pub fn grown_setup(scene: &Scene, chosen: &Chosen, vectors: &[Vec<f64>], settings: &Settings) -> Result<SetupData, PhysicsError> {
+/// data a modal space is built from; with cubature forces the cubature
+/// trained again on the training poses and the stretch's `seen` poses
+/// (displacements from the linearization point).
+pub fn grown_setup(scene: &Scene, loads: &Loads, chosen: &Chosen, vectors: &[Vec<f64>], seen: &[Vec<f64>]) -> Result<SetupData, PhysicsError> {
     let modes = match basis::orthonormal_ritz(scene, &chosen.pattern, &chosen.stiffness, vectors, vectors.len()) {
         Err(PhysicsError::BasisDeficient { found, .. }) if found > 0 => basis::orthonormal_ritz(scene, &chosen.pattern, &chosen.stiffness, vectors, found)?,
         other => other?,
     };
     let omega_sq_bound = basis_bound(scene, &modes)?;
-    Ok(SetupData {
+    let data = SetupData {
         basis: modes,
         point: chosen.data.point.clone(),
-        at_rest: settings.linearization == Linearization::Rest,
+        at_rest: chosen.settings.linearization == Linearization::Rest,
         omega_sq_bound,
         cubature: None,
         range: None,
-    })
+    };
+    if chosen.settings.force_evaluation != ForceEvaluation::Cubature {
+        return Ok(data);
+    }
+    let (b, t) = (&data.basis, &chosen.data.basis);
+    let mut d = vec![0.0; b.n];
+    let project = |x: &[f64]| -> Vec<f64> {
+        let mut q = vec![0.0; b.r];
+        b.project_displacement(&scene.dof_mass, x, &mut q);
+        q
+    };
+    let mut poses: Vec<Vec<f64>> = Vec::with_capacity(chosen.poses.len() + seen.len());
+    for qt in &chosen.poses {
+        for (i, di) in d.iter_mut().enumerate() {
+            *di = t.phi[i * t.r..(i + 1) * t.r].iter().zip(qt).map(|(p, q)| p * q).sum();
+        }
+        poses.push(project(&d));
+    }
+    poses.extend(seen.iter().map(|s| project(s)));
+    let settings = Settings { n_modes: b.r, ..chosen.settings.clone() };
+    cubature_training::train(scene.clone(), loads, &settings, Some(&data), Some(&poses))
 }

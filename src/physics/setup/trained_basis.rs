@@ -267,7 +267,7 @@ pub fn train(scene: Scene, loads: &Loads, settings: &Settings) -> Result<SetupDa
     let columns = snapshots(&scene, loads, settings, &point)?;
     let at = Linearized { point, pattern: &pattern, stiffness: &stiffness };
     let statics = fixed_vectors(&scene, loads, settings, &at)?;
-    train_on(scene, loads, settings, at, statics, columns)
+    train_on(scene, loads, settings, at, statics, &columns)
 }
 
 /// Where a basis is linearized: the point x*, and the stiffness K(x*) on its pattern.
@@ -301,13 +301,13 @@ pub fn train_on(
     settings: &Settings,
     at: Linearized,
     statics: Vec<Vec<f64>>,
-    columns: Vec<Vec<f64>>,
+    columns: &[Vec<f64>],
 ) -> Result<SetupData, PhysicsError> {
     let r = settings.n_modes;
     let Linearized { point, pattern, stiffness } = at;
     let p = statics.len().min(r);
     // A few more components than needed stand in for static responses the components already hold.
-    let components = principal_components(&scene.dof_mass, &columns, r + p)?;
+    let components = principal_components(&scene.dof_mass, columns, r + p)?;
     let mut vectors: Vec<Vec<f64>> = components[..(r - p).min(components.len())].to_vec();
     vectors.extend(statics);
     vectors.extend(components.iter().skip(r - p).cloned());
@@ -321,7 +321,6 @@ pub fn train_on(
             q
         })
         .collect();
-    drop(columns);
     let range = TrainedRange::of(&poses, r);
     let at_rest = settings.linearization == Linearization::Rest;
     let data = SetupData { basis: modes, point, at_rest, omega_sq_bound, cubature: None, range: Some(range) };

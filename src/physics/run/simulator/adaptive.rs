@@ -48,6 +48,12 @@ pub const FALL_BACK: f64 = 0.4;
 pub const STRETCH: usize = 4;
 /// The longest stretch, in communication steps, and the most poses a stretch keeps.
 pub const LONGEST_STRETCH: usize = 256;
+/// One estimate costs about this many passes over every spring.
+pub const ESTIMATE_COST: f64 = 10.0;
+/// The estimates cost at most this share of the springs the steps visit.
+pub const ESTIMATE_SHARE: f64 = 0.25;
+/// The longest gap between two estimates, in communication steps.
+pub const LONGEST_GAP: u64 = 32;
 const KEPT_POSES: usize = 32;
 
 /// What the estimate of E counts: sums over the communication points.
@@ -95,12 +101,28 @@ pub struct Adaptive<F: ReducedForce, R: Scheme, X: Scheme> {
     tally: Tally,
     spare_tally: Tally,
     residual: Vec<f64>,
+    /// The estimate's schedule: communication steps between estimates now
+    /// (1 after every change, doubling up to `period`), steps and time since the last one.
+    gap: u64,
+    period: u64,
+    wait: u64,
+    since: f64,
+    /// ‖e‖²_M and Σ m |x − x0|² at the last estimate, which stand for the steps until the next.
+    last_error_sq: f64,
+    last_motion_sq: f64,
     /// Node positions at the start and each node's mass, for the motion.
     start: Vec<f64>,
     node_mass: Vec<f64>,
     /// The stretch in full space: its poses (displacements from x*), its length and the length it should reach.
     seen: Vec<Vec<f64>>,
+    seen_count: usize,
+    seen_next: usize,
     stretch: usize,
+    /// The state the full-space run takes on a fall-back, and the reduced run's state to undo a step to.
+    lifted: State,
+    rewind: State,
+    /// Φᵀ M Δc of a holder's kick (see [`Self::kick_error`]).
+    kick_q: Vec<f64>,
     stretch_target: usize,
     settings: Settings,
     /// Gravity and the point load at set-up, about which the training program varies them.
@@ -134,13 +156,11 @@ fn copy_loads(dst: &mut Loads, src: &Loads) {
 impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// Set-up: the basis chosen for the tolerance ([`adaptive_basis::choose`]),
     /// the reduced run on it, the full-space run and the error model.
-    pub fn new(scene: Scene, settings: &Settings, loads: &Loads) -> Result<Self, PhysicsError> {
-        positive(Quantity::ErrorTolerance, settings.error_tolerance)?;
-        let chosen = adaptive_basis::choose(&scene, loads, settings)?;
+    pub fn new(scene: Scene, settings: &Settings, loads: &Loads, chosen: Chosen) -> Result<Self, PhysicsError> {
         let full_settings = inner_settings(settings, Reduction::Full, 0);
         let full_loads = Loads { mode_weights: Vec::new(), ..loads.clone() };
         let full = Run::new(Full::new(scene.clone(), &full_loads, &full_settings)?, &full_settings, &full_loads)?;
-        let reduced = reduced_run(&scene, settings, loads, &chosen.data)?;
+        let reduced = reduced_run(&scene, &chosen.settings, loads, &chosen.data)?;
         let model = ErrorModel::new(&scene.dof_mass, chosen.pattern.clone(), chosen.stiffness.clone())?;
         let n = scene.n_dofs();
         let node_mass = node_masses(&scene);
@@ -155,10 +175,21 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             tally: Tally::default(),
             spare_tally: Tally::default(),
             residual: vec![0.0; n],
+            gap: 1,
+            period: 1,
+            wait: 0,
+            since: 0.0,
+            last_error_sq: 0.0,
+            last_motion_sq: 0.0,
             start: Vec::new(),
             node_mass,
-            seen: Vec::with_capacity(KEPT_POSES),
+            seen: vec![vec![0.0; n]; KEPT_POSES],
+            seen_count: 0,
+            seen_next: 0,
             stretch: 0,
+            lifted: State::at_rest(n),
+            rewind: State::at_rest(0),
+            kick_q: Vec::new(),
             stretch_target: STRETCH,
             settings: settings.clone(),
             setup_gravity: loads.gravity,
@@ -171,6 +202,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             chosen,
         };
         run.start = run.reduced.positions().to_vec();
+        run.rewind = run.reduced.state.clone();
+        run.kick_q = vec![0.0; run.reduced.space.basis().r];
         run.report_basis();
         run.report_coordinates();
         Ok(run)
@@ -244,22 +277,81 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             .sum()
     }
 
-    /// The error model's step over `h` in the reduced run, and the step's count.
-    fn estimate_reduced(&mut self, h: f64) -> Result<(), PhysicsError> {
-        let felt = self.reduced.felt_loads();
-        let q = &self.reduced.state.y;
-        self.reduced.space.residual_force(&felt.gravity, &felt.point_load, q, &mut self.reduced.work, &mut self.residual);
-        self.reduced.current = false;
-        let x = self.reduced.space.positions(&self.reduced.state.y, &mut self.reduced.work);
-        self.model.relinearize(self.reduced.space.scene(), x);
-        self.model.advance(&mut self.error, h, &self.residual)?;
-        let motion = self.motion_sq();
-        self.tally.error_sq += self.model.norm_sq(&self.error);
-        self.tally.motion_sq += motion;
-        let steps = self.reduced.internal_steps_last as u64;
-        self.tally.reduced_steps += steps;
-        self.tally.steps += steps;
+    /// The estimate over the `since` seconds since the last one: the error
+    /// model's step under the residual at the state (none in full space),
+    /// at the tangent there; its ‖e‖² and the motion stand for the `wait`
+    /// communication steps since the last estimate.
+    fn estimate(&mut self) -> Result<(), PhysicsError> {
+        if self.in_full {
+            self.residual.fill(0.0);
+            let x = self.full.space.positions(&self.full.state.y, &mut self.full.work);
+            self.model.relinearize(self.full.space.scene(), x);
+        } else {
+            let felt = self.reduced.felt_loads();
+            let q = &self.reduced.state.y;
+            self.reduced.space.residual_force(&felt.gravity, &felt.point_load, q, &mut self.reduced.work, &mut self.residual);
+            self.reduced.current = false;
+            let x = self.reduced.space.positions(&self.reduced.state.y, &mut self.reduced.work);
+            self.model.relinearize(self.reduced.space.scene(), x);
+        }
+        self.model.advance(&mut self.error, self.since, &self.residual)?;
+        self.last_error_sq = self.model.norm_sq(&self.error);
+        self.last_motion_sq = self.motion_sq();
+        let w = self.wait as f64;
+        self.tally.error_sq += w * self.last_error_sq;
+        self.tally.motion_sq += w * self.last_motion_sq;
+        self.wait = 0;
+        self.since = 0.0;
+        self.gap = (2 * self.gap).min(self.period);
         Ok(())
+    }
+
+    /// The longest gap between estimates: one estimate (a spring pass, the
+    /// tangent's assembly, a factorization and a solve: about
+    /// [`ESTIMATE_COST`] passes over every spring) costs at most
+    /// [`ESTIMATE_SHARE`] of the springs the steps between visit.
+    fn update_period(&mut self) {
+        let all = self.reduced.scene().springs.len() as f64;
+        let visited = if self.in_full {
+            all * self.full.internal_steps_last.max(1) as f64
+        } else {
+            (self.reduced.cubature_springs() * self.reduced.internal_steps_last.max(1)) as f64
+        };
+        self.period = ((ESTIMATE_COST * all / (ESTIMATE_SHARE * visited)).ceil() as u64).clamp(1, LONGEST_GAP);
+    }
+
+    /// The holder's translation changes its velocity at the start of a step
+    /// (it moves at a constant rate to its target): every free node gets
+    /// -Δc relative to it in full space, the reduced run only the part Φ Φᵀ M
+    /// of that its basis holds. The rest, -(I - Φ Φᵀ M) Δc, is an error of
+    /// the velocity, added to the error model's e' (a turning holder's
+    /// kicks are not counted). O(n r) when the holder's velocity changes.
+    fn kick_error(&mut self, h: f64) {
+        let d = self.reduced.scene().dim;
+        let s = &self.reduced.state;
+        let kick: [f64; 3] = std::array::from_fn(|i| if i < d { s.anchor_rate[i] - (self.loads.anchor[i] - s.anchor[i]) / h } else { 0.0 });
+        if kick == [0.0; 3] || s.rotation != [0.0; 3] {
+            return;
+        }
+        let b = self.reduced.space.basis();
+        let mass = &self.reduced.scene().dof_mass;
+        // q = Φᵀ M u for u = Δc on every free node.
+        self.kick_q.fill(0.0);
+        for i in 0..b.n {
+            let mu = mass[i] * kick[i % d];
+            for (q, p) in self.kick_q.iter_mut().zip(&b.phi[i * b.r..(i + 1) * b.r]) {
+                *q += p * mu;
+            }
+        }
+        for i in 0..b.n {
+            let held: f64 = b.phi[i * b.r..(i + 1) * b.r].iter().zip(&self.kick_q).map(|(p, q)| p * q).sum();
+            self.error.v[i] -= kick[i % d] - held;
+        }
+    }
+
+    /// Estimates from the next step on again 1, 2, 4, ... steps apart (after a change).
+    fn estimate_soon(&mut self) {
+        self.gap = 1;
     }
 
     /// The loads are outside the training program the basis was trained
@@ -295,52 +387,56 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     }
 
     /// The estimated error of the state has passed its share of the tolerance.
-    fn must_fall_back(&mut self) -> bool {
-        let motion = self.motion_sq().max(self.chosen.motion_scale.powi(2));
-        let error = self.model.norm_sq(&self.error);
+    fn must_fall_back(&self) -> bool {
+        let motion = self.last_motion_sq.max(self.chosen.motion_scale.powi(2));
+        let error = self.last_error_sq;
         !(error <= (FALL_BACK * self.settings.error_tolerance).powi(2) * motion)
     }
 
     /// The reduced run's state undone to the start of its last step.
     fn undo_reduced(&mut self) {
-        let backup = self.reduced.backup.clone();
-        self.reduced.resume(&backup, false);
+        self.rewind.copy_from(&self.reduced.backup);
+        self.reduced.resume(&self.rewind, false);
     }
 
     /// The full-space run takes the reduced run's state: x = x* + Φ q, v = Φ q'.
     fn lift(&mut self) {
-        let (u, v) = self.reduced.dof_state();
-        let mut s = self.full.state.clone();
-        self.full.space.rest_coordinates(&mut s.y);
-        for (y, du) in s.y.iter_mut().zip(&u) {
-            *y += du;
+        // Full space's coordinates are the displacements from rest, u = x - x_rest.
+        let s = &mut self.lifted;
+        let x = self.reduced.space.positions(&self.reduced.state.y, &mut self.reduced.work);
+        let rest = &self.reduced.space.scene().rest;
+        for (k, y) in s.y.iter_mut().enumerate() {
+            *y = x[k] - rest[k];
         }
-        s.v.copy_from_slice(&v);
+        self.reduced.space.dof_velocities(&self.reduced.state.v, &mut s.v);
+        s.a.fill(0.0);
         s.copy_frame_from(&self.reduced.state);
-        self.full.resume(&s, true);
+        self.full.resume(&self.lifted, true);
         self.in_full = true;
-        self.seen.clear();
+        self.seen_count = 0;
         self.stretch = 0;
+        self.estimate_soon();
     }
 
     fn step_full(&mut self, h: f64) -> Result<(), PhysicsError> {
         self.full.do_step(h)?;
-        // Full space adds no error; the error carried moves on with the linearized dynamics.
-        self.residual.fill(0.0);
-        let x = self.full.space.positions(&self.full.state.y, &mut self.full.work);
-        self.model.relinearize(self.full.space.scene(), x);
-        self.model.advance(&mut self.error, h, &self.residual)?;
-        let motion = self.motion_sq();
-        self.tally.error_sq += self.model.norm_sq(&self.error);
-        self.tally.motion_sq += motion;
-        let steps = self.full.internal_steps_last as u64;
-        self.tally.steps += steps;
-        self.stretch += 1;
-        let pose = self.pose();
-        if self.seen.len() == KEPT_POSES {
-            self.seen.remove(0);
+        self.tally.steps += self.full.internal_steps_last as u64;
+        self.wait += 1;
+        self.since += h;
+        if self.wait >= self.gap {
+            // Full space adds no error; the error carried moves on with the linearized dynamics.
+            self.update_period();
+            self.estimate()?;
         }
-        self.seen.push(pose);
+        self.stretch += 1;
+        // The pose into the oldest of the kept ones.
+        let slot = &mut self.seen[self.seen_next];
+        let rest = &self.full.space.scene().rest;
+        for (i, (p, u)) in slot.iter_mut().zip(&self.full.state.y).enumerate() {
+            *p = u + rest[i] - self.chosen.data.point[i];
+        }
+        self.seen_next = (self.seen_next + 1) % KEPT_POSES;
+        self.seen_count = (self.seen_count + 1).min(KEPT_POSES);
         if self.stretch >= self.stretch_target {
             self.try_return()?;
         }
@@ -351,6 +447,11 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     fn pose(&self) -> Vec<f64> {
         let rest = &self.full.space.scene().rest;
         self.full.state.y.iter().enumerate().map(|(i, u)| u + rest[i] - self.chosen.data.point[i]).collect()
+    }
+
+    /// The poses of the stretch kept so far.
+    fn seen(&self) -> &[Vec<f64>] {
+        &self.seen[..self.seen_count]
     }
 
     /// Grows the basis from the stretch and returns to it if it holds the
@@ -364,7 +465,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         let size = self.chosen.data.basis.r;
         let count = ((GROWTH * size as f64).ceil() as usize).max(1);
         let current = self.reduced.space.basis().clone();
-        let new = adaptive_basis::new_directions(&scene, &current, &self.seen, count)?;
+        let new = adaptive_basis::new_directions(&scene, &current, self.seen(), count)?;
         let mut grown = self.grown.clone();
         grown.extend(new);
         let cap = (CAP_FACTOR * size).min(scene.n_dofs());
@@ -372,7 +473,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             grown.remove(0);
         }
         let vectors: Vec<Vec<f64>> = self.chosen.trained.iter().chain(&grown).cloned().collect();
-        let data = adaptive_basis::grown_setup(&scene, &self.chosen, &vectors, &self.settings)?;
+        let data = adaptive_basis::grown_setup(&scene, &self.loads, &self.chosen, &vectors, self.seen())?;
         // The grown basis must hold the state and the stretch's poses.
         let motion = self.motion_sq().max(self.chosen.motion_scale.powi(2));
         let limit = (PROJECTION_SHARE * self.settings.error_tolerance).powi(2) * motion;
@@ -390,12 +491,12 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         let v = &self.full.state.v;
         let speed: f64 = (0..v.len()).map(|i| scene.dof_mass[i] * v[i] * v[i]).sum();
         let holds_velocity = left(v) <= (PROJECTION_SHARE * self.settings.error_tolerance).powi(2) * speed;
-        if !holds_velocity || !self.seen.iter().all(|s| left(s) <= limit) {
+        if !holds_velocity || !self.seen().iter().all(|s| left(s) <= limit) {
             self.stretch = 0;
             self.stretch_target = (2 * self.stretch_target).min(LONGEST_STRETCH);
             return Ok(());
         }
-        let mut reduced = reduced_run(&scene, &self.settings, &self.loads, &data)?;
+        let mut reduced = reduced_run(&scene, &self.chosen.settings, &self.loads, &data)?;
         // q = Φᵀ M (x − x*), q' = Φᵀ M v; what the basis leaves out is the return's error.
         let pose = self.pose();
         let (mass, r) = (&scene.dof_mass, data.basis.r);
@@ -410,10 +511,13 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         }
         self.error.a.fill(0.0);
         reduced.resume(&s, true);
+        self.rewind = s;
         self.reduced = reduced;
+        self.kick_q = vec![0.0; self.reduced.space.basis().r];
         self.grown = grown;
         self.in_full = false;
         self.stretch = 0;
+        self.estimate_soon();
         self.report_basis();
         Ok(())
     }
@@ -450,17 +554,34 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
             self.lift();
             return self.step_full(h).inspect(|_| self.report_coordinates());
         }
-        self.spare_error.clone_from(&self.error);
-        self.spare_tally = self.tally;
+        let due = self.wait + 1 >= self.gap;
+        if due {
+            self.spare_error.copy_from(&self.error);
+            self.spare_tally = self.tally;
+        }
+        self.kick_error(h);
+        let (wait, since) = (self.wait, self.since);
         self.reduced.do_step(h)?;
-        let estimated = self.estimate_reduced(h);
+        let steps = self.reduced.internal_steps_last as u64;
+        self.tally.reduced_steps += steps;
+        self.tally.steps += steps;
+        self.wait += 1;
+        self.since += h;
+        if !due {
+            self.report_coordinates();
+            return Ok(());
+        }
+        self.update_period();
+        let estimated = self.estimate();
         if estimated.is_ok() && !self.must_fall_back() {
             self.report_coordinates();
             return Ok(());
         }
         // Undone, and taken again in full space from the lifted state.
-        self.error.clone_from(&self.spare_error);
+        self.error.copy_from(&self.spare_error);
         self.tally = self.spare_tally;
+        self.wait = wait;
+        self.since = since;
         self.undo_reduced();
         estimated?;
         self.lift();
@@ -510,6 +631,9 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
             let _ = self.reduced.edit_loads(&mut |l| copy_loads(l, host));
             let _ = self.full.edit_loads(&mut |l| copy_loads(l, host));
             return Err(e);
+        }
+        if !self.loads.same_but_anchor(&self.spare) {
+            self.estimate_soon();
         }
         Ok(())
     }
@@ -634,17 +758,6 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> SetUp for Adaptive<F, R, X> {
 }
 
 impl<S: Readout, I: Scheme> Run<S, I> {
-    /// The free DOFs' displacement from rest and velocity in the holder's frame.
-    fn dof_state(&mut self) -> (Vec<f64>, Vec<f64>) {
-        let n = self.space.scene().n_dofs();
-        let x = self.space.positions(&self.state.y, &mut self.work);
-        let rest = &self.space.scene().rest;
-        let u = (0..n).map(|k| x[k] - rest[k]).collect();
-        let mut v = vec![0.0; n];
-        self.space.dof_velocities(&self.state.v, &mut v);
-        (u, v)
-    }
-
     /// Continues from `s` under the run's loads: its accelerations made
     /// those of the state with `settle` (a state from elsewhere), kept otherwise (a state of this run).
     fn resume(&mut self, s: &State, settle: bool) {

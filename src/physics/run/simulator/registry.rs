@@ -12,7 +12,7 @@ use crate::physics::run::state::Loads;
 use crate::physics::settings::{ForceEvaluation, Integrator, ModeSelection, Reduction, Settings};
 use crate::physics::setup::scene::Scene;
 use crate::physics::setup::setup_data::SetupData;
-use crate::physics::setup::{cubature_training, trained_basis};
+use crate::physics::setup::{adaptive_basis, cubature_training, trained_basis};
 
 /// The run the settings chose, behind [`Sheet`]: every method of
 /// [`Steps`], [`Reads`] and [`SetUp`] is called on it directly.
@@ -92,11 +92,19 @@ fn build(scene: Scene, settings: &Settings, loads: &Loads, prebuilt: Option<&Set
             }
         },
         Reduction::Full => bind(Full::new(scene, loads, settings)?, settings, loads),
-        Reduction::Adaptive => Ok(match settings.integrator {
-            Integrator::NewmarkExplicit => Box::new(Adaptive::<Exact, NewmarkExplicit, NewmarkExplicit>::new(scene, settings, loads)?),
-            Integrator::NewmarkImplicit => Box::new(Adaptive::<Exact, NewmarkImplicit, NewmarkImplicit>::new(scene, settings, loads)?),
-            Integrator::Trigonometric => Box::new(Adaptive::<Exact, Trigonometric, NewmarkExplicit>::new(scene, settings, loads)?),
-        }),
+        Reduction::Adaptive => {
+            positive(Quantity::ErrorTolerance, settings.error_tolerance)?;
+            let chosen = adaptive_basis::choose(&scene, loads, settings)?;
+            let c = chosen.settings.force_evaluation == ForceEvaluation::Cubature;
+            Ok(match (settings.integrator, c) {
+                (Integrator::NewmarkExplicit, false) => Box::new(Adaptive::<Exact, NewmarkExplicit, NewmarkExplicit>::new(scene, settings, loads, chosen)?),
+                (Integrator::NewmarkImplicit, false) => Box::new(Adaptive::<Exact, NewmarkImplicit, NewmarkImplicit>::new(scene, settings, loads, chosen)?),
+                (Integrator::Trigonometric, false) => Box::new(Adaptive::<Exact, Trigonometric, NewmarkExplicit>::new(scene, settings, loads, chosen)?),
+                (Integrator::NewmarkExplicit, true) => Box::new(Adaptive::<Cubature, NewmarkExplicit, NewmarkExplicit>::new(scene, settings, loads, chosen)?),
+                (Integrator::NewmarkImplicit, true) => Box::new(Adaptive::<Cubature, NewmarkImplicit, NewmarkImplicit>::new(scene, settings, loads, chosen)?),
+                (Integrator::Trigonometric, true) => Box::new(Adaptive::<Cubature, Trigonometric, NewmarkExplicit>::new(scene, settings, loads, chosen)?),
+            })
+        }
     }
 }
 
