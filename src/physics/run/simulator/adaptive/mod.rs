@@ -26,16 +26,17 @@
 //! and its basis changes as it grows (as in full space, they act with
 //! the modal reduction only).
 
-use super::{Reads, ReductionStatus, Run, SetUp, Steps};
-use crate::physics::error::{positive, PhysicsError, Quantity};
+mod sheet;
+
+use super::{Reads, Run, SetUp, Steps};
+use crate::physics::error::PhysicsError;
 use crate::physics::run::error_model::{ErrorModel, ErrorState};
 use crate::physics::run::frame::dot;
 use crate::physics::run::integrator::Scheme;
 use crate::physics::run::space::{Constants, Full, Modal, Readout, ReducedForce};
-use crate::physics::run::state::{Loads, Snapshot, State};
+use crate::physics::run::state::{Loads, State};
 use crate::physics::settings::{ModeSelection, Reduction, Settings};
 use crate::physics::setup::adaptive_basis::{self, Chosen, CAP_FACTOR, GROWTH, PROJECTION_SHARE};
-use crate::physics::setup::mode_classes::ModeClasses;
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
 use crate::physics::setup::setup_data::SetupData;
@@ -535,226 +536,6 @@ fn reduced_run<F: ReducedForce, R: Scheme>(scene: &Scene, settings: &Settings, l
 fn node_masses(scene: &Scene) -> Vec<f64> {
     let typical = scene.dof_mass.first().copied().unwrap_or(1.0);
     scene.slot_of_node.iter().map(|&s| if s < scene.n_free { scene.dof_mass[s * scene.dim] } else { typical }).collect()
-}
-
-impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
-    fn max_stable_step(&self) -> f64 {
-        self.active().max_stable_step()
-    }
-
-    fn do_step(&mut self, h: f64) -> Result<(), PhysicsError> {
-        positive(Quantity::StepSize, h)?;
-        if self.in_full {
-            self.step_full(h)?;
-            self.report_coordinates();
-            return Ok(());
-        }
-        if self.outside_program() {
-            // A basis trained for other loads: full space from the start of the step.
-            self.lift();
-            return self.step_full(h).inspect(|_| self.report_coordinates());
-        }
-        let due = self.wait + 1 >= self.gap;
-        if due {
-            self.spare_error.copy_from(&self.error);
-            self.spare_tally = self.tally;
-        }
-        self.kick_error(h);
-        let (wait, since) = (self.wait, self.since);
-        self.reduced.do_step(h)?;
-        let steps = self.reduced.internal_steps_last as u64;
-        self.tally.reduced_steps += steps;
-        self.tally.steps += steps;
-        self.wait += 1;
-        self.since += h;
-        if !due {
-            self.report_coordinates();
-            return Ok(());
-        }
-        self.update_period();
-        let estimated = self.estimate();
-        if estimated.is_ok() && !self.must_fall_back() {
-            self.report_coordinates();
-            return Ok(());
-        }
-        // Undone, and taken again in full space from the lifted state.
-        self.error.copy_from(&self.spare_error);
-        self.tally = self.spare_tally;
-        self.wait = wait;
-        self.since = since;
-        self.undo_reduced();
-        estimated?;
-        self.lift();
-        if let Err(e) = self.step_full(h) {
-            self.in_full = false;
-            return Err(e);
-        }
-        self.report_coordinates();
-        Ok(())
-    }
-
-    fn scene(&self) -> &Scene {
-        self.reduced.scene()
-    }
-
-    fn time(&self) -> f64 {
-        self.active().time()
-    }
-
-    fn n_dofs(&self) -> usize {
-        self.reduced.n_dofs()
-    }
-
-    fn loads(&self) -> &Loads {
-        &self.loads
-    }
-
-    fn settings(&self) -> &Settings {
-        &self.settings
-    }
-
-    fn internal_steps_last(&self) -> usize {
-        self.active().internal_steps_last()
-    }
-
-    fn edit_loads(&mut self, edit: &mut dyn FnMut(&mut Loads)) -> Result<(), PhysicsError> {
-        self.spare.clone_from(&self.loads);
-        edit(&mut self.loads);
-        let checked = self.loads.validate(self.settings.n_modes).and_then(|()| self.loads.validate_on(self.reduced.scene()));
-        let host = &self.loads;
-        let applied =
-            checked.and_then(|()| self.reduced.edit_loads(&mut |l| copy_loads(l, host))).and_then(|()| self.full.edit_loads(&mut |l| copy_loads(l, host)));
-        if let Err(e) = applied {
-            std::mem::swap(&mut self.loads, &mut self.spare);
-            let host = &self.loads;
-            // Both runs accept the loads they had.
-            let _ = self.reduced.edit_loads(&mut |l| copy_loads(l, host));
-            let _ = self.full.edit_loads(&mut |l| copy_loads(l, host));
-            return Err(e);
-        }
-        if !self.loads.same_but_anchor(&self.spare) {
-            self.estimate_soon();
-        }
-        Ok(())
-    }
-
-    fn displace(&mut self, dy: &[f64]) -> Result<(), PhysicsError> {
-        self.active_mut().displace(dy)?;
-        self.report_coordinates();
-        Ok(())
-    }
-
-    fn displace_dofs(&mut self, dy: &[f64]) -> Result<(), PhysicsError> {
-        self.active_mut().displace_dofs(dy)?;
-        self.report_coordinates();
-        Ok(())
-    }
-
-    fn snapshot(&self) -> Snapshot {
-        self.active().snapshot()
-    }
-
-    fn restore(&mut self, s: &Snapshot) -> Result<(), PhysicsError> {
-        if self.in_full || !self.grown.is_empty() {
-            return Err(PhysicsError::AdaptiveState);
-        }
-        self.reduced.restore(s)
-    }
-}
-
-impl<F: ReducedForce, R: Scheme, X: Scheme> Reads for Adaptive<F, R, X> {
-    fn positions(&mut self) -> &[f64] {
-        self.active_mut().positions()
-    }
-
-    fn velocities(&mut self) -> &[f64] {
-        self.active_mut().velocities()
-    }
-
-    fn load_node_position(&mut self) -> Option<[f64; 3]> {
-        self.active_mut().load_node_position()
-    }
-
-    fn load_node_velocity(&mut self) -> Option<[f64; 3]> {
-        self.active_mut().load_node_velocity()
-    }
-
-    fn anchor_force(&mut self) -> [f64; 3] {
-        self.active_mut().anchor_force()
-    }
-
-    fn anchor_torque(&mut self) -> [f64; 3] {
-        self.active_mut().anchor_torque()
-    }
-
-    fn holder_force(&mut self, k: usize) -> [f64; 3] {
-        self.active_mut().holder_force(k)
-    }
-
-    fn holder_torque(&mut self, k: usize) -> [f64; 3] {
-        self.active_mut().holder_torque(k)
-    }
-
-    fn kinetic_energy(&self) -> f64 {
-        self.active().kinetic_energy()
-    }
-
-    fn potential_energy(&mut self) -> f64 {
-        self.active_mut().potential_energy()
-    }
-
-    fn force_residual(&mut self) -> f64 {
-        self.active_mut().force_residual()
-    }
-
-    fn modal_coordinates(&self) -> &[f64] {
-        &self.coordinates
-    }
-
-    fn spring_force(&mut self, y: &[f64]) -> Result<Vec<f64>, PhysicsError> {
-        self.active_mut().spring_force(y)
-    }
-
-    fn training_range(&self) -> f64 {
-        self.active().training_range()
-    }
-}
-
-impl<F: ReducedForce, R: Scheme, X: Scheme> SetUp for Adaptive<F, R, X> {
-    fn mode_frequencies(&self) -> &[f64] {
-        &self.frequencies
-    }
-
-    fn mode_shapes(&self) -> Option<&ModalBasis> {
-        Some(&self.reported)
-    }
-
-    fn mode_classes(&self) -> ModeClasses {
-        let mut c = self.reduced.mode_classes();
-        c.out_of_plane.resize(self.reported.r, 0.0);
-        c.symmetry.resize(self.reported.r, 0.0);
-        c
-    }
-
-    fn mode_grid_shapes(&self) -> Vec<f64> {
-        crate::physics::setup::mode_classes::grid_shapes(self.reduced.scene(), &self.reported)
-    }
-
-    fn setup_data(&self) -> Option<SetupData> {
-        None
-    }
-
-    fn cubature_springs(&self) -> usize {
-        self.active().cubature_springs()
-    }
-
-    fn reduction_status(&self) -> ReductionStatus {
-        ReductionStatus {
-            error_estimate: self.tally.estimate(),
-            reduced_fraction: self.tally.reduced_fraction(),
-            basis_size: if self.in_full { self.reduced.n_dofs() } else { self.reduced.space.basis().r },
-        }
-    }
 }
 
 impl<S: Readout, I: Scheme> Run<S, I> {
