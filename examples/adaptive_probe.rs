@@ -5,7 +5,7 @@
 //! basis size every 0.1 s, and the run time against full space
 //! (`docs/method.md`, section 10).
 //!
-//! `cargo run --release --example adaptive_probe -- [N] [TOLERANCE]`
+//! `cargo run --release --example adaptive_probe -- [N] [TOLERANCE]` (`ONLY=case` runs one case)
 
 use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::physics::*;
@@ -38,8 +38,16 @@ fn main() {
         full_settings.max_internal_step = fine;
     }
     let full = base.with_settings(full_settings);
-    let ad = base.with_settings(Settings { error_tolerance: tol, ..Settings::new(Reduction::Adaptive, Integrator::NewmarkExplicit, 2) });
+    let mut ad_settings = Settings { error_tolerance: tol, ..Settings::new(Reduction::Adaptive, Integrator::NewmarkExplicit, 2) };
+    if std::env::var("CUBATURE").is_ok() {
+        ad_settings.force_evaluation = ForceEvaluation::Cubature;
+    }
+    let ad = base.with_settings(ad_settings);
+    let only = std::env::var("ONLY").ok();
     for (name, g) in cases {
+        if only.as_deref().is_some_and(|o| o != name) {
+            continue;
+        }
         let mut f = full.simulator().unwrap();
         let t0 = Instant::now();
         let mut m = ad.simulator().unwrap();
@@ -59,7 +67,8 @@ fn main() {
             tf += t.elapsed().as_secs_f64();
             let t = Instant::now();
             m.do_step(H).unwrap();
-            tm += t.elapsed().as_secs_f64();
+            let dt = t.elapsed().as_secs_f64();
+            tm += dt;
             let (xf, xm) = (f.positions().to_vec(), m.positions().to_vec());
             num += xf.iter().zip(&xm).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
             den += xf.iter().zip(&x0).map(|(a, b)| (a - b) * (a - b)).sum::<f64>();
@@ -69,12 +78,13 @@ fn main() {
                 let e = xf.iter().zip(&xm).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
                 let d = xf.iter().zip(&x0).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
                 println!(
-                    "  t {:.2} e {e:.4} d {d:.3} e/d {:.4} E {:.4} est {:.4} basis {}",
+                    "  t {:.2} e {e:.4} d {d:.3} e/d {:.4} E {:.4} est {:.4} basis {} step {:.3} ms",
                     k as f64 * H,
                     e / d,
                     (num / den).sqrt(),
                     st.error_estimate,
-                    st.basis_size
+                    st.basis_size,
+                    dt * 1e3
                 );
             }
             if k % 10 == 0 {
