@@ -110,3 +110,86 @@ fn a_holder_shaken_beyond_the_program_makes_the_estimate_fall_back() {
     assert!(o.reduced < 0.9, "the run fell back: {} reduced", o.reduced);
     assert!(within_bounds(&o, tolerance), "estimate {} against E {}", o.estimate, o.e);
 }
+
+/// An adaptive run (tolerance 0.01) from set-up to step `steps` with the
+/// loads `load(k, loads)` before step k, from `from` (a snapshot taken before
+/// step `at`) if given: the positions after each step, snapshots before the
+/// steps `snapshots_at` and the basis size there.
+fn positions_under(
+    load: fn(usize, &Loads) -> Loads,
+    from: Option<(&Snapshot, usize)>,
+    snapshots_at: &[usize],
+    steps: usize,
+) -> (Vec<Vec<f64>>, Vec<Snapshot>, Vec<usize>) {
+    let mut base = canonical_scenes::cloth(30, 30);
+    base.loads.damping_alpha = 0.0;
+    base.loads.damping_beta = 0.0;
+    let adaptive = Settings { error_tolerance: 0.01, ..Settings::new(Reduction::Adaptive, Integrator::NewmarkExplicit, 2) };
+    let mut sim = base.with_settings(adaptive).simulator().unwrap();
+    let first = match from {
+        Some((s, at)) => {
+            sim.restore(s).unwrap();
+            at
+        }
+        None => 0,
+    };
+    let (mut positions, mut snapshots, mut sizes) = (Vec::new(), Vec::new(), Vec::new());
+    for k in first..steps {
+        if snapshots_at.contains(&k) {
+            snapshots.push(sim.snapshot());
+            sizes.push(sim.reduction_status().basis_size as usize);
+        }
+        let loads = load(k, sim.loads());
+        sim.set_loads(&loads).unwrap();
+        sim.do_step(H).unwrap();
+        positions.push(sim.positions().to_vec());
+    }
+    (positions, snapshots, sizes)
+}
+
+/// The holder shaken 5 cm at 2 Hz along x.
+fn shaken(k: usize, l: &Loads) -> Loads {
+    let x = 0.05 * (2.0 * std::f64::consts::PI * 2.0 * (k + 1) as f64 * H).sin();
+    Loads { anchor: [x, 0.0, 0.0], ..l.clone() }
+}
+
+/// A point load of 2 N sideways on the load node for the first 0.05 s.
+fn pushed(k: usize, l: &Loads) -> Loads {
+    Loads { point_load: if k < 5 { [2.0, 0.0, 2.0] } else { [0.0; 3] }, ..l.clone() }
+}
+
+/// Each snapshot, restored in a new run, continues as the run did, bit for bit.
+fn resumes_bit_for_bit(load: fn(usize, &Loads) -> Loads, at: &[usize]) -> Vec<usize> {
+    let (original, snapshots, sizes) = positions_under(load, None, at, STEPS);
+    for (s, &k) in snapshots.iter().zip(at) {
+        let (resumed, _, _) = positions_under(load, Some((s, k)), &[], STEPS);
+        assert_eq!(resumed.len(), STEPS - k);
+        for (j, (a, b)) in resumed.iter().zip(&original[k..]).enumerate() {
+            assert!(a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()), "step {} after the snapshot of step {k} differs", j + 1);
+        }
+    }
+    sizes
+}
+
+#[test]
+fn a_snapshot_resumes_the_run_bit_for_bit_in_either_mode() {
+    let n = 3 * 30 * 29;
+    let at = [0, 1, 2, 12, 30, 45];
+    let sizes = resumes_bit_for_bit(shaken, &at);
+    println!("shaken: basis size at steps {at:?}: {sizes:?}");
+    assert!(sizes.contains(&n) && sizes.iter().any(|&s| s < n), "the run holds a reduced and a full-space state");
+    let at = [3, 20, 40, 55];
+    let sizes = resumes_bit_for_bit(pushed, &at);
+    println!("pushed for 0.05 s: basis size at steps {at:?}: {sizes:?}");
+    // A state of a run without the adaptive part is refused, and the run keeps its own.
+    let (_, mut s, _) = positions_under(shaken, None, &[5], 6);
+    let mut plain = s.remove(0);
+    plain.adaptive = None;
+    let mut base = canonical_scenes::cloth(30, 30);
+    base.loads.damping_alpha = 0.0;
+    base.loads.damping_beta = 0.0;
+    let mut sim = base.with_settings(Settings::new(Reduction::Adaptive, Integrator::NewmarkExplicit, 2)).simulator().unwrap();
+    let before = sim.snapshot();
+    assert!(matches!(sim.restore(&plain), Err(PhysicsError::AdaptiveState { .. })));
+    assert_eq!(sim.snapshot(), before);
+}

@@ -85,7 +85,7 @@ fn measured_omega(samples: &[f64], dt: f64) -> f64 {
 fn oscillate(sim: &mut Simulator, flat: Vec<f64>, j: usize, dt: f64, steps: usize) -> Vec<f64> {
     let mut t = sim.loads().clone();
     t.gravity = [0.0; 3];
-    sim.restore(&Snapshot { state: state(flat), loads: t }).unwrap();
+    sim.restore(&Snapshot { state: state(flat), loads: t, adaptive: None }).unwrap();
     (0..steps)
         .map(|_| {
             sim.do_step(dt).unwrap();

@@ -30,10 +30,10 @@ pub const MAGIC: &[u8; 8] = b"MMSFMU3S";
 /// 5: the holder's orientation and spin, and its target; 6: holders 2 to 4
 /// (their motions in the state, their targets among the loads) and the
 /// variables that set them; 7: the variables of a later table (those with
-/// `since_format` 7). Formats 5 and 6
+/// `since_format` 7); 8: an adaptive run's part after the loads. Formats 5 to 7
 /// are still read: the holders 2 to 4 of format 5 are at rest and the
 /// variables a format lacks take their start values.
-pub const VERSION: u32 = 7;
+pub const VERSION: u32 = 8;
 /// The oldest format read.
 pub const OLDEST: u32 = 5;
 /// Bytes before the payload.
@@ -108,8 +108,9 @@ pub fn decode(bytes: &[u8]) -> Result<FmuState, String> {
         return Err(format!("serialized state format {version}, this FMU reads formats {OLDEST} to {VERSION}"));
     }
     let fp = u64::from_le_bytes(bytes[12..20].try_into().unwrap());
-    let layout = if version == VERSION { Some(LAYOUT_FINGERPRINT) } else { OLDER_LAYOUT_FINGERPRINTS.iter().find(|(f, _)| *f == version).map(|(_, l)| *l) };
-    if layout != Some(fp) {
+    // Formats after the newest variable's share the current layout.
+    let layout = OLDER_LAYOUT_FINGERPRINTS.iter().find(|(f, _)| *f == version).map_or(LAYOUT_FINGERPRINT, |(_, l)| *l);
+    if layout != fp {
         return Err("serialized state of a different model description".into());
     }
     let len = u64::from_le_bytes(bytes[20..28].try_into().unwrap());

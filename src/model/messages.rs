@@ -144,7 +144,7 @@ pub fn describe(e: &PhysicsError, p: &Params) -> String {
         Holders(problem) => holders(problem, p),
         SnapshotLength { len, expected } => format!("the state holds {len} values per array, this scene needs {expected}"),
         SnapshotNotFinite => "the state holds non-finite values".into(),
-        AdaptiveState => "reduction = adaptive: a state after the run fell back to full space or grew its basis cannot be restored yet".into(),
+        AdaptiveState { why } => format!("reduction = adaptive: the state cannot be restored: {why}"),
     }
 }
 

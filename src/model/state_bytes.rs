@@ -4,10 +4,13 @@
 //! its displacement, velocity, rotation vector and spin; then the loads:
 //! gravity, point load, load node, anchor and holder targets, (format 6)
 //! per holder 2 to 4 its displacement and rotation targets, damping,
-//! weights. Format 5 has no holders 2 to 4: they are at rest.
+//! weights; then (format 8) whether an adaptive part follows and the part:
+//! the mode, e, e', e'' of the error model, the estimate's sums, counts and
+//! schedule, the stretch's counters, its poses and the grown vectors.
+//! Format 5 has no holders 2 to 4: they are at rest.
 
-use crate::bytes::{put_f64, put_f64s, put_u64, Reader};
-use crate::physics::{Loads, Motion, Pose, Snapshot, State, OTHER_HOLDERS};
+use crate::bytes::{put_f64, put_f64s, put_u64, put_u8, Reader};
+use crate::physics::{AdaptivePart, Loads, Motion, Pose, Snapshot, State, OTHER_HOLDERS};
 
 pub fn write(snap: &Snapshot, p: &mut Vec<u8>) {
     let s = &snap.state;
@@ -30,6 +33,52 @@ pub fn write(snap: &Snapshot, p: &mut Vec<u8>) {
     put_f64(p, l.damping_alpha);
     put_f64(p, l.damping_beta);
     put_f64s(p, &l.mode_weights);
+    let Some(a) = &snap.adaptive else {
+        put_u8(p, 0);
+        return;
+    };
+    put_u8(p, 1);
+    put_u8(p, u8::from(a.in_full));
+    a.error.iter().for_each(|e| put_f64s(p, e));
+    a.sums.iter().for_each(|x| put_f64(p, *x));
+    a.counts.iter().chain(&a.stretch).for_each(|c| put_u64(p, *c));
+    for list in [&a.seen, &a.grown] {
+        put_u64(p, list.len() as u64);
+        list.iter().for_each(|v| put_f64s(p, v));
+    }
+}
+
+/// A count of vectors, each at least 8 bytes long in what is left.
+fn vectors(r: &mut Reader) -> Result<Vec<Vec<f64>>, String> {
+    let count = r.u64()?;
+    if count > (r.remaining() / 8) as u64 {
+        return Err(format!("the adaptive part claims {count} vectors, more than the state holds"));
+    }
+    (0..count).map(|_| r.f64s().map_err(String::from)).collect()
+}
+
+fn adaptive_part(r: &mut Reader) -> Result<Option<Box<AdaptivePart>>, String> {
+    match r.u8()? {
+        0 => return Ok(None),
+        1 => {}
+        f => return Err(format!("the adaptive part's flag is {f}, not 0 or 1")),
+    }
+    let in_full = match r.u8()? {
+        0 => false,
+        1 => true,
+        m => return Err(format!("the adaptive run's mode is {m}, not 0 or 1")),
+    };
+    let error = [r.f64s()?, r.f64s()?, r.f64s()?];
+    let mut sums = [0.0; 5];
+    for x in &mut sums {
+        *x = r.f64()?;
+    }
+    let (mut counts, mut stretch) = ([0; 5], [0; 3]);
+    for c in counts.iter_mut().chain(&mut stretch) {
+        *c = r.u64()?;
+    }
+    let (seen, grown) = (vectors(r)?, vectors(r)?);
+    Ok(Some(Box::new(AdaptivePart { in_full, error, sums, counts, stretch, seen, grown })))
 }
 
 fn vector(r: &mut Reader) -> Result<[f64; 3], String> {
@@ -73,5 +122,6 @@ pub fn read(r: &mut Reader, format: u32) -> Result<Snapshot, String> {
         return Err(format!("the simulator state holds arrays of {}, {} and {} values", state.y.len(), state.v.len(), state.a.len()));
     }
     let loads = Loads { gravity, point_load, load_node, anchor, rotation, holders: poses, damping_alpha, damping_beta, mode_weights };
-    Ok(Snapshot { state, loads })
+    let adaptive = if format >= 8 { adaptive_part(r)? } else { None };
+    Ok(Snapshot { state, loads, adaptive })
 }

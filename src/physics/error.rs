@@ -289,9 +289,9 @@ pub enum PhysicsError {
     /// A snapshot holding NaN or infinite values.
     #[error("the snapshot holds non-finite values")]
     SnapshotNotFinite,
-    /// An adaptive run in full space or with a grown basis cannot yet be restored from a snapshot.
-    #[error("an adaptive run that has fallen back to full space or grown its basis cannot be restored from a snapshot")]
-    AdaptiveState,
+    /// A snapshot an adaptive run cannot resume from, and why.
+    #[error("an adaptive run cannot resume from this snapshot: {why}")]
+    AdaptiveState { why: &'static str },
 }
 
 /// Why the held nodes cannot be given to the holders (holders counted from 1).

@@ -305,9 +305,40 @@ impl Loads {
     }
 }
 
-/// A state with the loads acting on it.
+/// A state with the loads acting on it (and, for an adaptive run, what it
+/// keeps beside the state of the run that steps).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Snapshot {
     pub state: State,
     pub loads: Loads,
+    pub adaptive: Option<Box<AdaptivePart>>,
+}
+
+/// What an adaptive run keeps beside the state of the run that steps
+/// (`docs/method.md`, section 10): its mode, the error model's state, the
+/// estimate's sums and schedule, the stretch in full space and the vectors
+/// its basis grew by.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AdaptivePart {
+    pub in_full: bool,
+    /// e, e', e'' of the error model (free DOFs).
+    pub error: [Vec<f64>; 3],
+    /// Σ ‖ê‖²_M, Σ ‖x − x0‖²_M, ‖e‖²_M and Σ m |x − x0|² at the last estimate, the time since it.
+    pub sums: [f64; 5],
+    /// Internal steps reduced and in all; the estimate's gap, period and steps since the last.
+    pub counts: [u64; 5],
+    /// Steps of the stretch in full space, the length it should reach, the next pose slot.
+    pub stretch: [u64; 3],
+    /// The stretch's poses kept (displacements from the linearization point).
+    pub seen: Vec<Vec<f64>>,
+    /// The vectors the basis grew by, oldest first.
+    pub grown: Vec<Vec<f64>>,
+}
+
+impl AdaptivePart {
+    /// Every value is finite and every vector has `n` values.
+    pub fn fits(&self, n: usize) -> bool {
+        let vectors = self.error.iter().chain(&self.seen).chain(&self.grown);
+        vectors.clone().all(|v| v.len() == n) && vectors.flatten().chain(&self.sums).all(|x| x.is_finite())
+    }
 }

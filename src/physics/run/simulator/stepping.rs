@@ -556,7 +556,7 @@ impl<S: Readout, I: Scheme> Steps for Run<S, I> {
     }
 
     fn snapshot(&self) -> Snapshot {
-        Snapshot { state: self.state.clone(), loads: self.loads().clone() }
+        Snapshot { state: self.state.clone(), loads: self.loads().clone(), adaptive: None }
     }
 
     fn restore(&mut self, s: &Snapshot) -> Result<(), PhysicsError> {

@@ -55,7 +55,8 @@ pub const ESTIMATE_COST: f64 = 10.0;
 pub const ESTIMATE_SHARE: f64 = 0.25;
 /// The longest gap between two estimates, in communication steps.
 pub const LONGEST_GAP: u64 = 32;
-const KEPT_POSES: usize = 32;
+/// The most poses of a stretch in full space kept for the basis to grow by.
+pub const KEPT_POSES: usize = 32;
 
 /// What the estimate of E counts: sums over the communication points.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -415,6 +416,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         self.full.resume(&self.lifted, true);
         self.in_full = true;
         self.seen_count = 0;
+        self.seen_next = 0;
         self.stretch = 0;
         self.estimate_soon();
     }
@@ -473,19 +475,16 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         while self.chosen.trained.len() + grown.len() > cap && !grown.is_empty() {
             grown.remove(0);
         }
-        let vectors: Vec<Vec<f64>> = self.chosen.trained.iter().chain(&grown).cloned().collect();
-        let data = adaptive_basis::grown_setup(&scene, &self.loads, &self.chosen, &vectors, self.seen())?;
+        let mut reduced = self.grown_run(&grown, self.seen(), &self.loads)?;
+        let basis = reduced.space.basis().clone();
         // The grown basis must hold the state and the stretch's poses.
         let motion = self.motion_sq().max(self.chosen.motion_scale.powi(2));
         let limit = (PROJECTION_SHARE * self.settings.error_tolerance).powi(2) * motion;
         let left = |s: &[f64]| -> f64 {
-            let mut q = vec![0.0; data.basis.r];
-            data.basis.project_displacement(&scene.dof_mass, s, &mut q);
+            let mut q = vec![0.0; basis.r];
+            basis.project_displacement(&scene.dof_mass, s, &mut q);
             (0..s.len())
-                .map(|i| {
-                    scene.dof_mass[i]
-                        * (s[i] - data.basis.phi[i * data.basis.r..(i + 1) * data.basis.r].iter().zip(&q).map(|(p, q)| p * q).sum::<f64>()).powi(2)
-                })
+                .map(|i| scene.dof_mass[i] * (s[i] - basis.phi[i * basis.r..(i + 1) * basis.r].iter().zip(&q).map(|(p, q)| p * q).sum::<f64>()).powi(2))
                 .sum()
         };
         // And the state's velocity, to the same share of its own size.
@@ -497,16 +496,15 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             self.stretch_target = (2 * self.stretch_target).min(LONGEST_STRETCH);
             return Ok(());
         }
-        let mut reduced = reduced_run(&scene, &self.chosen.settings, &self.loads, &data)?;
         // q = Φᵀ M (x − x*), q' = Φᵀ M v; what the basis leaves out is the return's error.
         let pose = self.pose();
-        let (mass, r) = (&scene.dof_mass, data.basis.r);
+        let (mass, r) = (&scene.dof_mass, basis.r);
         let mut s = reduced.state.clone();
-        data.basis.project_displacement(mass, &pose, &mut s.y);
-        data.basis.project_displacement(mass, &self.full.state.v, &mut s.v);
+        basis.project_displacement(mass, &pose, &mut s.y);
+        basis.project_displacement(mass, &self.full.state.v, &mut s.v);
         s.copy_frame_from(&self.full.state);
         for i in 0..pose.len() {
-            let row = &data.basis.phi[i * r..(i + 1) * r];
+            let row = &basis.phi[i * r..(i + 1) * r];
             self.error.e[i] += pose[i] - row.iter().zip(&s.y).map(|(p, q)| p * q).sum::<f64>();
             self.error.v[i] += self.full.state.v[i] - row.iter().zip(&s.v).map(|(p, q)| p * q).sum::<f64>();
         }
@@ -521,6 +519,17 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         self.estimate_soon();
         self.report_basis();
         Ok(())
+    }
+}
+
+impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
+    /// The modal run on the trained vectors and `grown` (with cubature forces,
+    /// the cubature trained on the program's poses and `seen`), under `loads`.
+    fn grown_run(&self, grown: &[Vec<f64>], seen: &[Vec<f64>], loads: &Loads) -> Result<Run<Modal<F>, R>, PhysicsError> {
+        let scene = self.full.space.scene();
+        let vectors: Vec<Vec<f64>> = self.chosen.trained.iter().chain(grown).cloned().collect();
+        let data = adaptive_basis::grown_setup(scene, loads, &self.chosen, &vectors, seen)?;
+        reduced_run(scene, &self.chosen.settings, loads, &data)
     }
 }
 

@@ -1,13 +1,13 @@
 //! What the model and the tests use of an adaptive run: [`Steps`],
 //! [`Reads`] and [`SetUp`], each answered by the run that steps now.
 
-use super::{copy_loads, Adaptive};
+use super::{copy_loads, Adaptive, CAP_FACTOR, KEPT_POSES, LONGEST_STRETCH};
 use crate::physics::error::{positive, PhysicsError, Quantity};
 use crate::physics::run::integrator::Scheme;
 use crate::physics::run::simulator::{Reads, ReductionStatus, SetUp, Steps};
 use crate::physics::run::space::ReducedForce;
-use crate::physics::run::state::{Loads, Snapshot};
-use crate::physics::settings::Settings;
+use crate::physics::run::state::{AdaptivePart, Loads, Snapshot};
+use crate::physics::settings::{ForceEvaluation, Settings};
 use crate::physics::setup::mode_classes::ModeClasses;
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
@@ -127,14 +127,85 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
     }
 
     fn snapshot(&self) -> Snapshot {
-        self.active().snapshot()
+        let mut s = self.active().snapshot();
+        s.loads = self.loads.clone();
+        s.adaptive = Some(Box::new(AdaptivePart {
+            in_full: self.in_full,
+            error: [self.error.e.clone(), self.error.v.clone(), self.error.a.clone()],
+            sums: [self.tally.error_sq, self.tally.motion_sq, self.last_error_sq, self.last_motion_sq, self.since],
+            counts: [self.tally.reduced_steps, self.tally.steps, self.gap, self.period, self.wait],
+            stretch: [self.stretch as u64, self.stretch_target as u64, self.seen_next as u64],
+            seen: self.seen().to_vec(),
+            grown: self.grown.clone(),
+        }));
+        s
     }
 
+    /// Resumes from a snapshot of an adaptive run of the same scene and
+    /// settings, in the mode and on the basis it had: a basis grown
+    /// otherwise than this run's is built again from the vectors (as the run
+    /// that grew it did). All or nothing.
     fn restore(&mut self, s: &Snapshot) -> Result<(), PhysicsError> {
-        if self.in_full || !self.grown.is_empty() {
-            return Err(PhysicsError::AdaptiveState);
+        let refuse = |why| Err(PhysicsError::AdaptiveState { why });
+        let Some(part) = s.adaptive.as_deref() else {
+            return refuse("it is not a state of an adaptive run");
+        };
+        let n = self.reduced.scene().n_dofs();
+        let [stretch, target, next] = part.stretch.map(|c| usize::try_from(c).unwrap_or(usize::MAX));
+        let cap = (CAP_FACTOR * self.chosen.data.basis.r).min(n);
+        if !part.fits(n)
+            || part.seen.len() > KEPT_POSES
+            || next >= KEPT_POSES
+            || !(1..=LONGEST_STRETCH).contains(&target)
+            || stretch > LONGEST_STRETCH
+            || part.counts[2] == 0
+            || part.counts[3] == 0
+            || part.counts[0] > part.counts[1]
+            || self.chosen.trained.len() + part.grown.len() > cap
+            || part.sums.iter().any(|x| *x < 0.0)
+        {
+            return refuse("its adaptive part does not fit this scene (corrupt or of another set-up)");
         }
-        self.reduced.restore(s)
+        s.loads.validate(self.settings.n_modes)?;
+        // The basis the state grew to, built as the run that grew it built it.
+        let mut rebuilt = None;
+        if part.grown != self.grown {
+            if self.chosen.settings.force_evaluation == ForceEvaluation::Cubature {
+                return refuse("its basis grew otherwise than this run's, and with cubature forces a grown basis is not rebuilt yet");
+            }
+            rebuilt = Some(self.grown_run(&part.grown, &part.seen, &s.loads)?);
+        }
+        let inner = |weights: Vec<f64>| Snapshot { state: s.state.clone(), loads: Loads { mode_weights: weights, ..s.loads.clone() }, adaptive: None };
+        if part.in_full {
+            self.full.restore(&inner(Vec::new()))?;
+        } else {
+            let target = rebuilt.as_mut().unwrap_or(&mut self.reduced);
+            let r = target.space.basis().r;
+            target.restore(&inner(vec![1.0; r]))?;
+        }
+        if let Some(run) = rebuilt {
+            self.reduced = run;
+            self.rewind = self.reduced.state.clone();
+            self.kick_q = vec![0.0; self.reduced.space.basis().r];
+            self.grown = part.grown.clone();
+            self.report_basis();
+        }
+        self.in_full = part.in_full;
+        let [e, v, a] = &part.error;
+        self.error.e.copy_from_slice(e);
+        self.error.v.copy_from_slice(v);
+        self.error.a.copy_from_slice(a);
+        [self.tally.error_sq, self.tally.motion_sq, self.last_error_sq, self.last_motion_sq, self.since] = part.sums;
+        [self.tally.reduced_steps, self.tally.steps, self.gap, self.period, self.wait] = part.counts;
+        (self.stretch, self.stretch_target, self.seen_next) = (stretch, target, next);
+        for (slot, pose) in self.seen.iter_mut().zip(&part.seen) {
+            slot.copy_from_slice(pose);
+        }
+        self.seen_count = part.seen.len();
+        copy_loads(&mut self.loads, &s.loads);
+        self.loads.mode_weights.clone_from(&s.loads.mode_weights);
+        self.report_coordinates();
+        Ok(())
     }
 }
 
