@@ -16,6 +16,7 @@
 //! One modal force evaluation is the pipeline `expand` (q -> x) -> exact
 //! spring forces in physical space -> `project` (Phi^T f).
 
+pub mod error_directions;
 pub mod error_model;
 pub mod forces;
 pub mod frame;

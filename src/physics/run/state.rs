@@ -336,9 +336,11 @@ pub struct AdaptivePart {
 }
 
 impl AdaptivePart {
-    /// Every value is finite and every vector has `n` values.
-    pub fn fits(&self, n: usize) -> bool {
-        let vectors = self.error.iter().chain(&self.seen).chain(&self.grown);
-        vectors.clone().all(|v| v.len() == n) && vectors.flatten().chain(&self.sums).all(|x| x.is_finite())
+    /// Every value is finite, every pose and grown vector has `n` values and
+    /// each of the error model's `error_len`.
+    pub fn fits(&self, n: usize, error_len: usize) -> bool {
+        self.seen.iter().chain(&self.grown).all(|v| v.len() == n)
+            && self.error.iter().all(|v| v.len() == error_len)
+            && self.error.iter().chain(&self.seen).chain(&self.grown).flatten().chain(&self.sums).all(|x| x.is_finite())
     }
 }

@@ -29,6 +29,7 @@
 //! the size chosen at set-up, the oldest dropped first.
 
 use crate::physics::error::PhysicsError;
+use crate::physics::run::error_directions::error_directions;
 use crate::physics::run::forces::StiffnessPattern;
 use crate::physics::run::space::basis_bound;
 use crate::physics::run::state::Loads;
@@ -37,7 +38,7 @@ use crate::physics::setup::basis;
 use crate::physics::setup::cubature_training::{self, MAX_MODES as MAX_CUBATURE_MODES};
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
-use crate::physics::setup::setup_data::SetupData;
+use crate::physics::setup::setup_data::{SetupData, SpringSet};
 use crate::physics::setup::trained_basis::{self, principal_components, Linearized};
 
 /// Share of the tolerance the held-out projection error may take.
@@ -69,13 +70,28 @@ pub struct Chosen {
     pub poses: Vec<Vec<f64>>,
     /// The settings of the trained basis: its size, force model and cubature tolerance.
     pub settings: Settings,
+    /// Candidates for the error model's directions: the held-out split's
+    /// principal components beyond the basis (up to [`ERROR_DIRECTIONS`]
+    /// times as many as it holds) and the rigid translations.
+    pub error_directions: Vec<Vec<f64>>,
+    /// With cubature forces, the error model's spring set (also the grown bases' cubature).
+    pub error_set: Option<SpringSet>,
 }
+
+/// The error model may take this many times as many principal components as the basis holds.
+pub const ERROR_DIRECTIONS: usize = 1;
 
 /// With cubature forces asked for, they are used when the scene has at least this many springs per basis vector.
 pub const CUBATURE_SPRINGS_PER_VECTOR: usize = 20;
+/// Cubature forces are used whatever was asked for when the scene has at
+/// least this many springs per basis vector: a cubature keeps about 10 to 30
+/// springs per vector, and a reduced step with exact forces visits every
+/// spring, as a full-space step does.
+pub const CUBATURE_PAYS: usize = 1000;
 
-/// The held-out projection error P(j) for j = 0 ..= components of `train` (see the module documentation).
-pub fn held_out_errors(mass: &[f64], train: &[Vec<f64>], held_out: &[Vec<f64>], components: usize) -> Result<Vec<f64>, PhysicsError> {
+/// The held-out projection error P(j) for j = 0 ..= components of `train`
+/// (see the module documentation), and the components.
+pub fn held_out_errors(mass: &[f64], train: &[Vec<f64>], held_out: &[Vec<f64>], components: usize) -> Result<(Vec<f64>, Vec<Vec<f64>>), PhysicsError> {
     let c = principal_components(mass, train, components)?;
     let total: f64 = held_out.iter().map(|d| m_dot(mass, d, d)).sum();
     let mut left = total;
@@ -84,7 +100,7 @@ pub fn held_out_errors(mass: &[f64], train: &[Vec<f64>], held_out: &[Vec<f64>], 
         left -= held_out.iter().map(|d| m_dot(mass, cj, d).powi(2)).sum::<f64>();
         errors.push(ratio(left.max(0.0), total));
     }
-    Ok(errors)
+    Ok((errors, c))
 }
 
 fn ratio(part: f64, total: f64) -> f64 {
@@ -111,19 +127,25 @@ pub fn choose(scene: &Scene, loads: &Loads, settings: &Settings) -> Result<Chose
         (e.into_iter().map(|(_, c)| c.clone()).collect(), o.into_iter().map(|(_, c)| c.clone()).collect())
     };
     let most = even.len().min(n);
-    let errors = held_out_errors(&scene.dof_mass, &even, &odd, most)?;
+    let (errors, mut pcs) = held_out_errors(&scene.dof_mass, &even, &odd, most)?;
     drop((even, odd));
     let target = PROJECTION_SHARE * settings.error_tolerance;
     let found = errors.iter().position(|&e| e <= target);
     let components = found.unwrap_or(errors.len() - 1).max(1);
+    // The error model's directions: the components beyond the basis, and the rigid translations.
+    let mut error_directions: Vec<Vec<f64>> = pcs.drain(..).skip(components).take(ERROR_DIRECTIONS * components).collect();
+    for axis in 0..scene.dim {
+        error_directions.push((0..n).map(|i| if i % scene.dim == axis { 1.0 } else { 0.0 }).collect());
+    }
     let motion_scale = (columns.iter().map(|d| m_dot(&scene.dof_mass, d, d)).sum::<f64>() / columns.len().max(1) as f64).sqrt();
     let at = Linearized { point, pattern: &pattern, stiffness: &stiffness };
     let statics = trained_basis::fixed_vectors(scene, loads, &trained_settings, &at)?;
     let size = (components + statics.len()).min(n);
-    // Cubature forces when asked for and they visit far fewer springs than every one, at the tolerance's accuracy.
-    let cubature = settings.force_evaluation == ForceEvaluation::Cubature
-        && scene.springs.len() >= CUBATURE_SPRINGS_PER_VECTOR * size
-        && CAP_FACTOR * size <= MAX_CUBATURE_MODES;
+    // Cubature forces where they pay (asked for, or a scene with many springs
+    // per vector), at the tolerance's accuracy, for the basis and the error directions.
+    let per_vector = scene.springs.len() / size.max(1);
+    let cubature = (per_vector >= CUBATURE_PAYS || settings.force_evaluation == ForceEvaluation::Cubature && per_vector >= CUBATURE_SPRINGS_PER_VECTOR)
+        && size + error_directions.len() <= MAX_CUBATURE_MODES;
     let sized = Settings {
         n_modes: size,
         force_evaluation: if cubature { ForceEvaluation::Cubature } else { ForceEvaluation::Exact },
@@ -131,7 +153,7 @@ pub fn choose(scene: &Scene, loads: &Loads, settings: &Settings) -> Result<Chose
         ..trained_settings
     };
     let data = trained_basis::train_on(scene.clone(), loads, &sized, at, statics, &columns)?;
-    let poses = columns
+    let poses: Vec<Vec<f64>> = columns
         .iter()
         .map(|d| {
             let mut q = vec![0.0; data.basis.r];
@@ -140,6 +162,7 @@ pub fn choose(scene: &Scene, loads: &Loads, settings: &Settings) -> Result<Chose
         })
         .collect();
     drop(columns);
+    let error_set = if cubature { Some(error_cubature(scene, loads, &sized, &data, &error_directions, &poses)?) } else { None };
     let trained = columns_of(&data.basis);
     Ok(Chosen {
         held_out_error: errors[components.min(errors.len() - 1)],
@@ -151,8 +174,39 @@ pub fn choose(scene: &Scene, loads: &Loads, settings: &Settings) -> Result<Chose
         stiffness,
         trained,
         poses,
+        error_directions,
+        error_set,
         settings: sized,
     })
+}
+
+/// The cubature of the error model (`crate::physics::run::error_directions`): a spring
+/// set trained on the program's poses `poses` (coordinates in `data`'s basis)
+/// for the forces projected on the basis and its error directions from
+/// `candidates` together.
+fn error_cubature(
+    scene: &Scene,
+    loads: &Loads,
+    settings: &Settings,
+    data: &SetupData,
+    candidates: &[Vec<f64>],
+    poses: &[Vec<f64>],
+) -> Result<SpringSet, PhysicsError> {
+    let b = &data.basis;
+    let directions = error_directions(&scene.dof_mass, b, candidates);
+    let (n, r, k) = (b.n, b.r, directions.len());
+    let mut phi = Vec::with_capacity(n * (r + k));
+    for i in 0..n {
+        phi.extend_from_slice(&b.phi[i * r..(i + 1) * r]);
+        phi.extend(directions.iter().map(|d| d[i]));
+    }
+    let top = b.lambda.iter().copied().fold(0.0, f64::max);
+    let lambda = b.lambda.iter().copied().chain(std::iter::repeat_n(top, k)).collect();
+    let joint = SetupData { basis: ModalBasis { n, r: r + k, lambda, phi }, cubature: None, range: None, ..data.clone() };
+    let padded: Vec<Vec<f64>> = poses.iter().map(|q| q.iter().copied().chain(std::iter::repeat_n(0.0, k)).collect()).collect();
+    let settings = Settings { n_modes: r + k, force_evaluation: ForceEvaluation::Cubature, ..settings.clone() };
+    let trained = cubature_training::train(scene.clone(), loads, &settings, Some(&joint), Some(&padded))?;
+    Ok(trained.cubature.expect("a cubature training gives a spring set"))
 }
 
 /// The columns of a basis (row-major n x r) as vectors.
@@ -188,41 +242,21 @@ pub fn new_directions(scene: &Scene, current: &ModalBasis, seen: &[Vec<f64>], co
 
 /// The basis of `vectors` (trained first, then grown), M-orthonormalized
 /// and diagonalized with the stiffness at the linearization point, as the
-/// data a modal space is built from; with cubature forces the cubature
-/// trained again on the training poses and the stretch's `seen` poses
-/// (displacements from the linearization point).
-pub fn grown_setup(scene: &Scene, loads: &Loads, chosen: &Chosen, vectors: &[Vec<f64>], seen: &[Vec<f64>]) -> Result<SetupData, PhysicsError> {
+/// data a modal space is built from; with cubature forces the error
+/// model's spring set serves it (trained for the set-up basis and the
+/// directions beyond it; not trained again).
+pub fn grown_setup(scene: &Scene, chosen: &Chosen, vectors: &[Vec<f64>]) -> Result<SetupData, PhysicsError> {
     let modes = match basis::orthonormal_ritz(scene, &chosen.pattern, &chosen.stiffness, vectors, vectors.len()) {
         Err(PhysicsError::BasisDeficient { found, .. }) if found > 0 => basis::orthonormal_ritz(scene, &chosen.pattern, &chosen.stiffness, vectors, found)?,
         other => other?,
     };
     let omega_sq_bound = basis_bound(scene, &modes)?;
-    let data = SetupData {
+    Ok(SetupData {
         basis: modes,
         point: chosen.data.point.clone(),
         at_rest: chosen.settings.linearization == Linearization::Rest,
         omega_sq_bound,
-        cubature: None,
+        cubature: chosen.error_set.clone(),
         range: None,
-    };
-    if chosen.settings.force_evaluation != ForceEvaluation::Cubature {
-        return Ok(data);
-    }
-    let (b, t) = (&data.basis, &chosen.data.basis);
-    let mut d = vec![0.0; b.n];
-    let project = |x: &[f64]| -> Vec<f64> {
-        let mut q = vec![0.0; b.r];
-        b.project_displacement(&scene.dof_mass, x, &mut q);
-        q
-    };
-    let mut poses: Vec<Vec<f64>> = Vec::with_capacity(chosen.poses.len() + seen.len());
-    for qt in &chosen.poses {
-        for (i, di) in d.iter_mut().enumerate() {
-            *di = t.phi[i * t.r..(i + 1) * t.r].iter().zip(qt).map(|(p, q)| p * q).sum();
-        }
-        poses.push(project(&d));
-    }
-    poses.extend(seen.iter().map(|s| project(s)));
-    let settings = Settings { n_modes: b.r, ..chosen.settings.clone() };
-    cubature_training::train(scene.clone(), loads, &settings, Some(&data), Some(&poses))
+    })
 }

@@ -19,12 +19,14 @@
 //!
 //! - here: the types;
 //! - `registry.rs`: which run the settings name, and [`Simulator`];
-//! - `adaptive.rs`: the adaptive reduction, a reduced run and its full-space twin;
+//! - `adaptive/`: the adaptive reduction, a reduced run and its full-space twin;
+//! - `estimators.rs`: the error models an adaptive run keeps;
 //! - `sheet.rs`: the traits;
 //! - `stepping.rs`: set-up of a run, the step, load changes, snapshots;
 //! - `outputs.rs`: what a host reads.
 
 mod adaptive;
+mod estimators;
 mod outputs;
 pub mod registry;
 mod sheet;

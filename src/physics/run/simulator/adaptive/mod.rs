@@ -26,13 +26,15 @@
 //! and its basis changes as it grows (as in full space, they act with
 //! the modal reduction only).
 
+mod estimate;
 mod sheet;
 
 use super::{Reads, Run, SetUp, Steps};
 use crate::physics::error::PhysicsError;
-use crate::physics::run::error_model::{ErrorModel, ErrorState};
+use crate::physics::run::error_model::ErrorState;
 use crate::physics::run::frame::dot;
 use crate::physics::run::integrator::Scheme;
+use crate::physics::run::simulator::estimators::Estimator;
 use crate::physics::run::space::{Constants, Full, Modal, Readout, ReducedForce};
 use crate::physics::run::state::{Loads, State};
 use crate::physics::settings::{ModeSelection, Reduction, Settings};
@@ -97,7 +99,7 @@ pub struct Adaptive<F: ReducedForce, R: Scheme, X: Scheme> {
     chosen: Chosen,
     /// The vectors grown so far, oldest first.
     grown: Vec<Vec<f64>>,
-    model: ErrorModel,
+    model: Estimator,
     error: ErrorState,
     spare_error: ErrorState,
     tally: Tally,
@@ -112,9 +114,9 @@ pub struct Adaptive<F: ReducedForce, R: Scheme, X: Scheme> {
     /// ‖e‖²_M and Σ m |x − x0|² at the last estimate, which stand for the steps until the next.
     last_error_sq: f64,
     last_motion_sq: f64,
-    /// Node positions at the start and each node's mass, for the motion.
+    /// Slot positions at the start and each slot's mass, for the motion.
     start: Vec<f64>,
-    node_mass: Vec<f64>,
+    slot_mass: Vec<f64>,
     /// The stretch in full space: its poses (displacements from x*), its length and the length it should reach.
     seen: Vec<Vec<f64>>,
     seen_count: usize,
@@ -163,17 +165,17 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         let full_loads = Loads { mode_weights: Vec::new(), ..loads.clone() };
         let full = Run::new(Full::new(scene.clone(), &full_loads, &full_settings)?, &full_settings, &full_loads)?;
         let reduced = reduced_run(&scene, &chosen.settings, loads, &chosen.data)?;
-        let model = ErrorModel::new(&scene.dof_mass, chosen.pattern.clone(), chosen.stiffness.clone())?;
+        let (model, error) = Estimator::new(&scene, &chosen, &chosen.data.basis)?;
         let n = scene.n_dofs();
-        let node_mass = node_masses(&scene);
+        let slot_mass = slot_masses(&scene);
         let mut run = Adaptive {
             reduced,
             full,
             in_full: false,
             grown: Vec::new(),
             model,
-            error: ErrorState::zero(n),
-            spare_error: ErrorState::zero(n),
+            spare_error: error.clone(),
+            error,
             tally: Tally::default(),
             spare_tally: Tally::default(),
             residual: vec![0.0; n],
@@ -184,7 +186,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             last_error_sq: 0.0,
             last_motion_sq: 0.0,
             start: Vec::new(),
-            node_mass,
+            slot_mass,
             seen: vec![vec![0.0; n]; KEPT_POSES],
             seen_count: 0,
             seen_next: 0,
@@ -203,7 +205,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             coordinates: vec![0.0; settings.n_modes],
             chosen,
         };
-        run.start = run.reduced.positions().to_vec();
+        run.start = run.reduced.space.positions(&run.reduced.state.y, &mut run.reduced.work).to_vec();
         run.rewind = run.reduced.state.clone();
         run.kick_q = vec![0.0; run.reduced.space.basis().r];
         run.report_basis();
@@ -271,41 +273,13 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// Σ m |x − x0|² over every node at the active run's positions.
     fn motion_sq(&mut self) -> f64 {
         let d = self.reduced.space.scene().dim;
-        let x = if self.in_full { self.full.positions() } else { self.reduced.positions() };
-        x.chunks_exact(d)
-            .zip(self.start.chunks_exact(d))
-            .zip(&self.node_mass)
-            .map(|((a, b), m)| m * a.iter().zip(b).map(|(p, q)| (p - q).powi(2)).sum::<f64>())
-            .sum()
-    }
-
-    /// The estimate over the `since` seconds since the last one: the error
-    /// model's step under the residual at the state (none in full space),
-    /// at the tangent there; its ‖e‖² and the motion stand for the `wait`
-    /// communication steps since the last estimate.
-    fn estimate(&mut self) -> Result<(), PhysicsError> {
-        if self.in_full {
-            self.residual.fill(0.0);
-            let x = self.full.space.positions(&self.full.state.y, &mut self.full.work);
-            self.model.relinearize(self.full.space.scene(), x);
+        let x = if self.in_full {
+            self.full.space.positions(&self.full.state.y, &mut self.full.work)
         } else {
-            let felt = self.reduced.felt_loads();
-            let q = &self.reduced.state.y;
-            self.reduced.space.residual_force(&felt.gravity, &felt.point_load, q, &mut self.reduced.work, &mut self.residual);
             self.reduced.current = false;
-            let x = self.reduced.space.positions(&self.reduced.state.y, &mut self.reduced.work);
-            self.model.relinearize(self.reduced.space.scene(), x);
-        }
-        self.model.advance(&mut self.error, self.since, &self.residual)?;
-        self.last_error_sq = self.model.norm_sq(&self.error);
-        self.last_motion_sq = self.motion_sq();
-        let w = self.wait as f64;
-        self.tally.error_sq += w * self.last_error_sq;
-        self.tally.motion_sq += w * self.last_motion_sq;
-        self.wait = 0;
-        self.since = 0.0;
-        self.gap = (2 * self.gap).min(self.period);
-        Ok(())
+            self.reduced.space.positions(&self.reduced.state.y, &mut self.reduced.work)
+        };
+        slot_motion(x, &self.start, &self.slot_mass, d)
     }
 
     /// The longest gap between estimates: one estimate (a spring pass, the
@@ -320,35 +294,6 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             (self.reduced.cubature_springs() * self.reduced.internal_steps_last.max(1)) as f64
         };
         self.period = ((ESTIMATE_COST * all / (ESTIMATE_SHARE * visited)).ceil() as u64).clamp(1, LONGEST_GAP);
-    }
-
-    /// The holder's translation changes its velocity at the start of a step
-    /// (it moves at a constant rate to its target): every free node gets
-    /// -Δc relative to it in full space, the reduced run only the part Φ Φᵀ M
-    /// of that its basis holds. The rest, -(I - Φ Φᵀ M) Δc, is an error of
-    /// the velocity, added to the error model's e' (a turning holder's
-    /// kicks are not counted). O(n r) when the holder's velocity changes.
-    fn kick_error(&mut self, h: f64) {
-        let d = self.reduced.scene().dim;
-        let s = &self.reduced.state;
-        let kick: [f64; 3] = std::array::from_fn(|i| if i < d { s.anchor_rate[i] - (self.loads.anchor[i] - s.anchor[i]) / h } else { 0.0 });
-        if kick == [0.0; 3] || s.rotation != [0.0; 3] {
-            return;
-        }
-        let b = self.reduced.space.basis();
-        let mass = &self.reduced.scene().dof_mass;
-        // q = Φᵀ M u for u = Δc on every free node.
-        self.kick_q.fill(0.0);
-        for i in 0..b.n {
-            let mu = mass[i] * kick[i % d];
-            for (q, p) in self.kick_q.iter_mut().zip(&b.phi[i * b.r..(i + 1) * b.r]) {
-                *q += p * mu;
-            }
-        }
-        for i in 0..b.n {
-            let held: f64 = b.phi[i * b.r..(i + 1) * b.r].iter().zip(&self.kick_q).map(|(p, q)| p * q).sum();
-            self.error.v[i] -= kick[i % d] - held;
-        }
     }
 
     /// Estimates from the next step on again 1, 2, 4, ... steps apart (after a change).
@@ -475,7 +420,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         while self.chosen.trained.len() + grown.len() > cap && !grown.is_empty() {
             grown.remove(0);
         }
-        let mut reduced = self.grown_run(&grown, self.seen(), &self.loads)?;
+        let mut reduced = self.grown_run(&grown, &self.loads)?;
         let basis = reduced.space.basis().clone();
         // The grown basis must hold the state and the stretch's poses.
         let motion = self.motion_sq().max(self.chosen.motion_scale.powi(2));
@@ -503,12 +448,13 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         basis.project_displacement(mass, &pose, &mut s.y);
         basis.project_displacement(mass, &self.full.state.v, &mut s.v);
         s.copy_frame_from(&self.full.state);
-        for i in 0..pose.len() {
+        let (mut left, mut left_rate) = (pose.clone(), self.full.state.v.clone());
+        for (i, (l, lr)) in left.iter_mut().zip(&mut left_rate).enumerate() {
             let row = &basis.phi[i * r..(i + 1) * r];
-            self.error.e[i] += pose[i] - row.iter().zip(&s.y).map(|(p, q)| p * q).sum::<f64>();
-            self.error.v[i] += self.full.state.v[i] - row.iter().zip(&s.v).map(|(p, q)| p * q).sum::<f64>();
+            *l -= row.iter().zip(&s.y).map(|(p, q)| p * q).sum::<f64>();
+            *lr -= row.iter().zip(&s.v).map(|(p, q)| p * q).sum::<f64>();
         }
-        self.error.a.fill(0.0);
+        self.carry_error(&basis, &left, &left_rate);
         reduced.resume(&s, true);
         self.rewind = s;
         self.reduced = reduced;
@@ -523,12 +469,11 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
 }
 
 impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
-    /// The modal run on the trained vectors and `grown` (with cubature forces,
-    /// the cubature trained on the program's poses and `seen`), under `loads`.
-    fn grown_run(&self, grown: &[Vec<f64>], seen: &[Vec<f64>], loads: &Loads) -> Result<Run<Modal<F>, R>, PhysicsError> {
+    /// The modal run on the trained vectors and `grown` under `loads`.
+    fn grown_run(&self, grown: &[Vec<f64>], loads: &Loads) -> Result<Run<Modal<F>, R>, PhysicsError> {
         let scene = self.full.space.scene();
         let vectors: Vec<Vec<f64>> = self.chosen.trained.iter().chain(grown).cloned().collect();
-        let data = adaptive_basis::grown_setup(scene, loads, &self.chosen, &vectors, seen)?;
+        let data = adaptive_basis::grown_setup(scene, &self.chosen, &vectors)?;
         reduced_run(scene, &self.chosen.settings, loads, &data)
     }
 }
@@ -541,10 +486,15 @@ fn reduced_run<F: ReducedForce, R: Scheme>(scene: &Scene, settings: &Settings, l
     Run::new(Modal::<F>::new(scene.clone(), &l, &s, Some(data))?, &s, &l)
 }
 
-/// Each node's mass in output order: a free node's, and for a held node that of the free nodes (the nodes of a grid all weigh the same).
-fn node_masses(scene: &Scene) -> Vec<f64> {
+/// Each slot's mass: a free node's, and for a held node that of the free nodes (the nodes of a grid all weigh the same).
+fn slot_masses(scene: &Scene) -> Vec<f64> {
     let typical = scene.dof_mass.first().copied().unwrap_or(1.0);
-    scene.slot_of_node.iter().map(|&s| if s < scene.n_free { scene.dof_mass[s * scene.dim] } else { typical }).collect()
+    (0..scene.slot_of_node.len()).map(|s| if s < scene.n_free { scene.dof_mass[s * scene.dim] } else { typical }).collect()
+}
+
+/// Σ m |x − x0|² over the slots of dimension `d`.
+fn slot_motion(x: &[f64], start: &[f64], mass: &[f64], d: usize) -> f64 {
+    x.chunks_exact(d).zip(start.chunks_exact(d)).zip(mass).map(|((a, b), m)| m * a.iter().zip(b).map(|(p, q)| (p - q).powi(2)).sum::<f64>()).sum()
 }
 
 impl<S: Readout, I: Scheme> Run<S, I> {

@@ -3,11 +3,13 @@
 
 use super::{copy_loads, Adaptive, CAP_FACTOR, KEPT_POSES, LONGEST_STRETCH};
 use crate::physics::error::{positive, PhysicsError, Quantity};
+use crate::physics::run::error_model::ErrorState;
 use crate::physics::run::integrator::Scheme;
+use crate::physics::run::simulator::estimators::Estimator;
 use crate::physics::run::simulator::{Reads, ReductionStatus, SetUp, Steps};
 use crate::physics::run::space::ReducedForce;
 use crate::physics::run::state::{AdaptivePart, Loads, Snapshot};
-use crate::physics::settings::{ForceEvaluation, Settings};
+use crate::physics::settings::Settings;
 use crate::physics::setup::mode_classes::ModeClasses;
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
@@ -153,7 +155,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
         let n = self.reduced.scene().n_dofs();
         let [stretch, target, next] = part.stretch.map(|c| usize::try_from(c).unwrap_or(usize::MAX));
         let cap = (CAP_FACTOR * self.chosen.data.basis.r).min(n);
-        if !part.fits(n)
+        let structure_fits = part.seen.iter().chain(&part.grown).all(|v| v.len() == n);
+        if !structure_fits
             || part.seen.len() > KEPT_POSES
             || next >= KEPT_POSES
             || !(1..=LONGEST_STRETCH).contains(&target)
@@ -170,10 +173,19 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
         // The basis the state grew to, built as the run that grew it built it.
         let mut rebuilt = None;
         if part.grown != self.grown {
-            if self.chosen.settings.force_evaluation == ForceEvaluation::Cubature {
-                return refuse("its basis grew otherwise than this run's, and with cubature forces a grown basis is not rebuilt yet");
-            }
-            rebuilt = Some(self.grown_run(&part.grown, &part.seen, &s.loads)?);
+            rebuilt = Some(self.grown_run(&part.grown, &s.loads)?);
+        }
+        // The error model beside that basis (in error directions it depends on the basis).
+        let model = match (&rebuilt, &self.model) {
+            (Some(run), Estimator::Directions(_)) => Some(Estimator::new(self.reduced.scene(), &self.chosen, run.space.basis())?.0),
+            _ => None,
+        };
+        let error_len = match &model {
+            Some(Estimator::Directions(m)) => m.directions(),
+            _ => self.error.e.len(),
+        };
+        if !part.fits(n, error_len) {
+            return refuse("its adaptive part does not fit this scene (corrupt or of another set-up)");
         }
         let inner = |weights: Vec<f64>| Snapshot { state: s.state.clone(), loads: Loads { mode_weights: weights, ..s.loads.clone() }, adaptive: None };
         if part.in_full {
@@ -190,11 +202,13 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
             self.grown = part.grown.clone();
             self.report_basis();
         }
+        if let Some(model) = model {
+            self.model = model;
+        }
         self.in_full = part.in_full;
         let [e, v, a] = &part.error;
-        self.error.e.copy_from_slice(e);
-        self.error.v.copy_from_slice(v);
-        self.error.a.copy_from_slice(a);
+        self.error = ErrorState { e: e.clone(), v: v.clone(), a: a.clone() };
+        self.spare_error = self.error.clone();
         [self.tally.error_sq, self.tally.motion_sq, self.last_error_sq, self.last_motion_sq, self.since] = part.sums;
         [self.tally.reduced_steps, self.tally.steps, self.gap, self.period, self.wait] = part.counts;
         (self.stretch, self.stretch_target, self.seen_next) = (stretch, target, next);

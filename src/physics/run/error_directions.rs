@@ -1,0 +1,326 @@
+//! The error model of a reduced run with cubature forces (`docs/method.md`,
+//! section 10): the model of [`crate::physics::run::error_model`] solved in a
+//! few error directions instead of full space, its force and stiffness
+//! evaluated on a cubature, so that an estimate costs about as much as a
+//! few reduced steps.
+//!
+//! The error e = x_full − x of the reduced trajectory x = x* + Φ q obeys,
+//! linearized, M e'' + K e = r with r = f(x) − M Φ Φᵀ f(x). The model keeps
+//! e ≈ Ψ z in k error directions Ψ (M-orthonormal and M-orthogonal to Φ:
+//! the principal components of the training program beyond the basis and the
+//! rigid translations a holder's kick leaves out of it), where
+//!
+//! ```text
+//! z'' + C z = Ψᵀ r = Ψᵀ f(x),    C = Ψᵀ K Ψ    (Ψᵀ M Φ = 0),
+//! ```
+//!
+//! integrated with the trapezoidal rule over the time since the last
+//! estimate, r and C taken at the step's end. Both come from a spring set S
+//! with weights w (the cubature of An, Kim and James, trained at set-up on
+//! the program's poses for the forces projected on [Φ Ψ]):
+//!
+//! ```text
+//! Ψᵀ f_springs(x) ≈ c + Σ_S w_e G_eᵀ g_e(x_b − x_a),    C ≈ Σ_S w_e G_eᵀ K_e G_e,
+//! ```
+//!
+//! G_e = Ψ_a − Ψ_b (the rows of the spring's ends, zero at a held end), g_e
+//! the spring's pull on end a, c = Ψᵀ f_springs(x*) − Σ_S w_e G_eᵀ g_e(x*)
+//! (exact at the linearization point), K_e the spring's tangent with the
+//! tension's geometric stiffness and without a compressed spring's
+//! negative one. Gravity adds Ψᵀ M g (three sums kept from set-up), a point
+//! load its node's rows. ‖e‖_M = |z|.
+//!
+//! One estimate: |S| (3 k² + 30) operations, a k x k Cholesky factorization
+//! and the slot positions of the state; nothing is allocated. What it leaves
+//! out: the error outside Φ and Ψ, the cubature's own error, and what the
+//! full-space model leaves out (the error of the coordinates the basis
+//! holds, a holder's inertial loads, buckling, full space's step error).
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch, LltRegularization};
+use faer::linalg::cholesky::llt::solve::solve_in_place_with_conj;
+use faer::{Conj, MatMut, MatRef, Par};
+
+use crate::physics::error::PhysicsError;
+use crate::physics::run::error_model::ErrorState;
+use crate::physics::run::forces::{block, pull};
+use crate::physics::setup::modes::ModalBasis;
+use crate::physics::setup::scene::Scene;
+use crate::physics::setup::setup_data::SpringSet;
+
+const BETA: f64 = 0.25;
+
+/// A candidate direction is kept if at least this share of it is left after
+/// removing its part in the basis and in the directions before it.
+const NEW_SHARE: f64 = 1e-6;
+
+/// The error directions beside `basis` from `candidates` (free DOFs of a
+/// scene with masses `mass`): each less its part in the basis and in the
+/// directions before it (twice, for round-off), M-normalized, kept if
+/// anything is left.
+pub fn error_directions(mass: &[f64], basis: &ModalBasis, candidates: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let dot = |u: &[f64], v: &[f64]| -> f64 { mass.iter().zip(u).zip(v).map(|((m, a), b)| m * a * b).sum() };
+    let mut kept: Vec<Vec<f64>> = Vec::new();
+    let mut q = vec![0.0; basis.r];
+    for c in candidates {
+        let size = dot(c, c).sqrt();
+        if !(size > 0.0) {
+            continue;
+        }
+        let mut u = c.clone();
+        for _ in 0..2 {
+            basis.project_displacement(mass, &u, &mut q);
+            for (i, ui) in u.iter_mut().enumerate() {
+                *ui -= basis.phi[i * basis.r..(i + 1) * basis.r].iter().zip(&q).map(|(p, q)| p * q).sum::<f64>();
+            }
+            for w in &kept {
+                let s = dot(w, &u);
+                u.iter_mut().zip(w).for_each(|(a, b)| *a -= s * b);
+            }
+        }
+        let left = dot(&u, &u).sqrt();
+        if left > NEW_SHARE * size {
+            u.iter_mut().for_each(|a| *a /= left);
+            kept.push(u);
+        }
+    }
+    kept
+}
+
+/// The constant part of the model and its scratch.
+pub struct DirectionModel {
+    dim: usize,
+    n: usize,
+    mass: Vec<f64>,
+    /// Ψ, row-major n x k.
+    psi: Vec<f64>,
+    k: usize,
+    /// The spring set: scene index and weight of each spring.
+    springs: Vec<usize>,
+    weights: Vec<f64>,
+    /// c, and Ψᵀ M e_axis for each axis.
+    offset: Vec<f64>,
+    mass_axis: Vec<f64>,
+    /// C (column-major k x k), I + h²/4 C and its factor, Ψᵀ r, the right-hand side.
+    c: Vec<f64>,
+    factor: Vec<f64>,
+    forcing: Vec<f64>,
+    rhs: Vec<f64>,
+    /// G_e of one spring (D x k) and K_e G_e.
+    g: Vec<f64>,
+    kg: Vec<f64>,
+    mem: MemBuffer,
+}
+
+impl DirectionModel {
+    /// The model in `directions` (see [`error_directions`]) on the spring set
+    /// `set`, exact at the slot positions `point` (x*).
+    pub fn new(scene: &Scene, directions: &[Vec<f64>], set: &SpringSet, point: &[f64]) -> Self {
+        let (d, n, k) = (scene.dim, scene.n_dofs(), directions.len());
+        let mut psi = vec![0.0; n * k];
+        for (j, w) in directions.iter().enumerate() {
+            for (i, x) in w.iter().enumerate() {
+                psi[i * k + j] = *x;
+            }
+        }
+        let mut mass_axis = vec![0.0; 3 * k];
+        for i in 0..n {
+            for j in 0..k {
+                mass_axis[(i % d) * k + j] += scene.dof_mass[i] * psi[i * k + j];
+            }
+        }
+        let req = cholesky_in_place_scratch::<f64>(k, Par::Seq, Default::default());
+        let mut model = DirectionModel {
+            dim: d,
+            n,
+            mass: scene.dof_mass.clone(),
+            psi,
+            k,
+            springs: set.springs.clone(),
+            weights: set.weights.clone(),
+            offset: vec![0.0; k],
+            mass_axis,
+            c: vec![0.0; k * k],
+            factor: vec![0.0; k * k],
+            forcing: vec![0.0; k],
+            rhs: vec![0.0; k],
+            g: vec![0.0; 3 * k],
+            kg: vec![0.0; 3 * k],
+            mem: MemBuffer::new(StackReq::any_of(&[req])),
+        };
+        // c = Ψᵀ f_springs(x*) − Σ_S w G_eᵀ g_e(x*).
+        let mut exact = vec![0.0; k];
+        for e in 0..scene.springs.len() {
+            model.add_spring(scene, point, e, 1.0, &mut exact, false);
+        }
+        let mut sampled = vec![0.0; k];
+        for (&e, &w) in set.springs.iter().zip(&set.weights) {
+            model.add_spring(scene, point, e, w, &mut sampled, false);
+        }
+        for ((o, a), b) in model.offset.iter_mut().zip(&exact).zip(&sampled) {
+            *o = a - b;
+        }
+        model
+    }
+
+    /// The number of error directions k.
+    pub fn directions(&self) -> usize {
+        self.k
+    }
+
+    /// out += w G_eᵀ g_e(x_b − x_a) for spring `e` at slot positions `x`, and
+    /// with `tangent` C += w G_eᵀ K_e G_e.
+    fn add_spring(&mut self, scene: &Scene, x: &[f64], e: usize, w: f64, out: &mut [f64], tangent: bool) {
+        match self.dim {
+            2 => self.add_spring_d::<2>(scene, x, e, w, out, tangent),
+            _ => self.add_spring_d::<3>(scene, x, e, w, out, tangent),
+        }
+    }
+
+    fn add_spring_d<const D: usize>(&mut self, scene: &Scene, x: &[f64], e: usize, w: f64, out: &mut [f64], tangent: bool) {
+        let (k, s) = (self.k, &scene.springs[e]);
+        let n_free = self.n / D;
+        // G = Ψ_a − Ψ_b, row i of the D rows for coordinate i.
+        let g = &mut self.g[..D * k];
+        g.fill(0.0);
+        for (slot, sign) in [(s.a, 1.0), (s.b, -1.0)] {
+            if slot < n_free {
+                for i in 0..D {
+                    for (gj, p) in g[i * k..(i + 1) * k].iter_mut().zip(&self.psi[(slot * D + i) * k..(slot * D + i + 1) * k]) {
+                        *gj += sign * p;
+                    }
+                }
+            }
+        }
+        let dv: [f64; D] = std::array::from_fn(|i| x[s.b * D + i] - x[s.a * D + i]);
+        let pulled = pull(&dv, s.k, s.rest);
+        for i in 0..D {
+            for (o, gj) in out.iter_mut().zip(&g[i * k..(i + 1) * k]) {
+                *o += w * gj * pulled[i];
+            }
+        }
+        if !tangent {
+            return;
+        }
+        let l = dv.iter().map(|c| c * c).sum::<f64>().sqrt();
+        let ke = block::<D>(&dv, s.k, s.rest.min(l));
+        let kg = &mut self.kg[..D * k];
+        for i in 0..D {
+            for j in 0..k {
+                kg[i * k + j] = (0..D).map(|m| ke[(i, m)] * g[m * k + j]).sum();
+            }
+        }
+        for b in 0..k {
+            for a in 0..=b {
+                let v: f64 = (0..D).map(|i| g[i * k + a] * kg[i * k + b]).sum();
+                self.c[b * k + a] += w * v;
+            }
+        }
+    }
+
+    /// C and Ψᵀ r at slot positions `x` under `gravity` and the point
+    /// force `point` (its first DOF and value), or C alone (r = 0: the run
+    /// is in full space, which adds no error).
+    pub fn linearize(&mut self, scene: &Scene, x: &[f64], loads: Option<(&[f64; 3], Option<(usize, &[f64])>)>) {
+        let k = self.k;
+        self.c.fill(0.0);
+        let mut forcing = std::mem::take(&mut self.forcing);
+        forcing.fill(0.0);
+        let (springs, weights) = (std::mem::take(&mut self.springs), std::mem::take(&mut self.weights));
+        for (&e, &w) in springs.iter().zip(&weights) {
+            self.add_spring(scene, x, e, w, &mut forcing, true);
+        }
+        (self.springs, self.weights) = (springs, weights);
+        for b in 0..k {
+            for a in 0..b {
+                self.c[a * k + b] = self.c[b * k + a];
+            }
+        }
+        match loads {
+            None => forcing.fill(0.0),
+            Some((gravity, point)) => {
+                for (j, f) in forcing.iter_mut().enumerate() {
+                    *f += self.offset[j] + (0..self.dim).map(|a| gravity[a] * self.mass_axis[a * k + j]).sum::<f64>();
+                }
+                if let Some((dof, p)) = point {
+                    for (i, pi) in p.iter().enumerate() {
+                        for (f, psi) in forcing.iter_mut().zip(&self.psi[(dof + i) * k..(dof + i + 1) * k]) {
+                            *f += psi * pi;
+                        }
+                    }
+                }
+            }
+        }
+        self.forcing = forcing;
+    }
+
+    /// Advances `s` by `h` under the forcing and C of the last [`Self::linearize`]:
+    /// a = (I + h²/4 C)⁻¹ (Ψᵀ r − C (z + h z' + h²/4 z'')),
+    /// z += h z' + h²/4 (z'' + a), z' += h/2 (z'' + a), z'' = a.
+    pub fn advance(&mut self, s: &mut ErrorState, h: f64) -> Result<(), PhysicsError> {
+        let k = self.k;
+        if k == 0 {
+            return Ok(());
+        }
+        let cc = BETA * h * h;
+        for j in 0..k {
+            s.e[j] += h * s.v[j] + cc * s.a[j];
+        }
+        for i in 0..k {
+            self.rhs[i] = self.forcing[i] - (0..k).map(|j| self.c[j * k + i] * s.e[j]).sum::<f64>();
+        }
+        for (f, c) in self.factor.iter_mut().zip(&self.c) {
+            *f = cc * c;
+        }
+        for j in 0..k {
+            self.factor[j * k + j] += 1.0;
+        }
+        let stack = MemStack::new(&mut self.mem);
+        cholesky_in_place(MatMut::from_column_major_slice_mut(&mut self.factor, k, k), LltRegularization::default(), Par::Seq, stack, Default::default())
+            .map_err(|e| PhysicsError::LinearAlgebra { what: "Cholesky factorization of the error model", detail: format!("{e:?}") })?;
+        let stack = MemStack::new(&mut self.mem);
+        solve_in_place_with_conj(
+            MatRef::from_column_major_slice(&self.factor, k, k),
+            Conj::No,
+            MatMut::from_column_major_slice_mut(&mut self.rhs, k, 1),
+            Par::Seq,
+            stack,
+        );
+        for j in 0..k {
+            let a = self.rhs[j];
+            s.e[j] += cc * a;
+            s.v[j] += 0.5 * h * (s.a[j] + a);
+            s.a[j] = a;
+        }
+        Ok(())
+    }
+
+    /// z += Ψᵀ M u, z' += Ψᵀ M w for a displacement error `u` and a velocity error `w` (free DOFs).
+    pub fn add(&self, s: &mut ErrorState, u: &[f64], w: &[f64]) {
+        let k = self.k;
+        for (i, row) in self.psi.chunks_exact(k.max(1)).enumerate().take(self.n) {
+            let (mu, mw) = (self.mass[i] * u[i], self.mass[i] * w[i]);
+            for j in 0..k {
+                s.e[j] += row[j] * mu;
+                s.v[j] += row[j] * mw;
+            }
+        }
+    }
+
+    /// z' += Ψᵀ M kick for the same velocity `kick` on every free node. O(k).
+    pub fn add_uniform_velocity(&self, s: &mut ErrorState, kick: &[f64; 3]) {
+        for j in 0..self.k {
+            s.v[j] += (0..self.dim).map(|a| kick[a] * self.mass_axis[a * self.k + j]).sum::<f64>();
+        }
+    }
+
+    /// Ψ z and Ψ z' over the free DOFs.
+    pub fn error_of(&self, s: &ErrorState) -> (Vec<f64>, Vec<f64>) {
+        let k = self.k.max(1);
+        let along = |c: &[f64]| -> Vec<f64> { self.psi.chunks_exact(k).map(|row| row.iter().zip(c).map(|(p, x)| p * x).sum()).collect() };
+        if self.k == 0 {
+            return (vec![0.0; self.n], vec![0.0; self.n]);
+        }
+        (along(&s.e), along(&s.v))
+    }
+}

@@ -1,0 +1,138 @@
+//! The estimate of an adaptive run, a holder's kicks in its error model
+//! and the error a return carries ([`crate::physics::run::simulator::estimators`]).
+
+use super::{slot_motion, Adaptive};
+use crate::physics::error::PhysicsError;
+use crate::physics::run::error_model::ErrorState;
+use crate::physics::run::integrator::Scheme;
+use crate::physics::run::simulator::estimators::Estimator;
+use crate::physics::run::simulator::Steps;
+use crate::physics::run::space::{Constants, Readout, ReducedForce};
+use crate::physics::setup::modes::ModalBasis;
+
+impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
+    /// The estimate over the `since` seconds since the last one: the error
+    /// model's step under the residual at the state, at the tangent there
+    /// (in full space: no residual, the full-space model at the tangent of
+    /// the last reduced estimate, nothing at all while no error is carried);
+    /// its ‖e‖² and the motion stand for the `wait` communication steps since the last estimate.
+    pub(super) fn estimate(&mut self) -> Result<(), PhysicsError> {
+        let carried = self.error.e.iter().chain(&self.error.v).chain(&self.error.a).any(|x| *x != 0.0);
+        let d = self.reduced.space.scene().dim;
+        // The motion from the slot positions the estimate has anyway.
+        let mut motion = None;
+        match &mut self.model {
+            // In full space no error is added: a zero error stays zero, a carried one moves on.
+            _ if self.in_full && !carried => {}
+            Estimator::Full(model) => {
+                if self.in_full {
+                    // At the tangent of the last estimate (factored already for the same gap).
+                    self.residual.fill(0.0);
+                } else {
+                    let felt = self.reduced.felt_loads();
+                    let q = &self.reduced.state.y;
+                    self.reduced.space.residual_force(&felt.gravity, &felt.point_load, q, &mut self.reduced.work, &mut self.residual);
+                    self.reduced.current = false;
+                    let x = self.reduced.space.positions(&self.reduced.state.y, &mut self.reduced.work);
+                    motion = Some(slot_motion(x, &self.start, &self.slot_mass, d));
+                    model.relinearize(self.reduced.space.scene(), x);
+                }
+                model.advance(&mut self.error, self.since, &self.residual)?;
+            }
+            Estimator::Directions(model) => {
+                if self.in_full {
+                    let x = self.full.space.positions(&self.full.state.y, &mut self.full.work);
+                    model.linearize(self.full.space.scene(), x, None);
+                } else {
+                    let felt = self.reduced.felt_loads();
+                    let scene = self.reduced.space.scene();
+                    let point = self.reduced.work.as_ref().point_force_as(&felt.point_load, scene).map(|(dof, f)| {
+                        let mut p = [0.0; 3];
+                        p[..f.len()].copy_from_slice(f);
+                        (dof, p, f.len())
+                    });
+                    let x = self.reduced.space.positions(&self.reduced.state.y, &mut self.reduced.work);
+                    motion = Some(slot_motion(x, &self.start, &self.slot_mass, d));
+                    let point = point.as_ref().map(|(dof, p, d)| (*dof, &p[..*d]));
+                    model.linearize(self.reduced.space.scene(), x, Some((&felt.gravity, point)));
+                    self.reduced.current = false;
+                }
+                model.advance(&mut self.error, self.since)?;
+            }
+        }
+        self.last_error_sq = self.model.norm_sq(&self.error);
+        self.last_motion_sq = match motion {
+            Some(m) => m,
+            None => self.motion_sq(),
+        };
+        let w = self.wait as f64;
+        self.tally.error_sq += w * self.last_error_sq;
+        self.tally.motion_sq += w * self.last_motion_sq;
+        self.wait = 0;
+        self.since = 0.0;
+        self.gap = (2 * self.gap).min(self.period);
+        Ok(())
+    }
+
+    /// The holder's translation changes its velocity at the start of a step
+    /// (it moves at a constant rate to its target): every free node gets
+    /// -Δc relative to it in full space, the reduced run only the part Φ Φᵀ M
+    /// of that its basis holds. The rest, -(I - Φ Φᵀ M) Δc, is an error of
+    /// the velocity, added to the error model's e' (a turning holder's
+    /// kicks are not counted). O(n r) when the holder's velocity changes.
+    pub(super) fn kick_error(&mut self, h: f64) {
+        let d = self.reduced.scene().dim;
+        let s = &self.reduced.state;
+        let kick: [f64; 3] = std::array::from_fn(|i| if i < d { s.anchor_rate[i] - (self.loads.anchor[i] - s.anchor[i]) / h } else { 0.0 });
+        if kick == [0.0; 3] || s.rotation != [0.0; 3] {
+            return;
+        }
+        let model = match &self.model {
+            Estimator::Directions(m) => {
+                // In the error directions, Ψᵀ M Φ = 0: the kick's part there is Ψᵀ M kick.
+                m.add_uniform_velocity(&mut self.error, &kick);
+                return;
+            }
+            Estimator::Full(m) => m,
+        };
+        let _ = model;
+        let b = self.reduced.space.basis();
+        let mass = &self.reduced.scene().dof_mass;
+        // q = Φᵀ M u for u = Δc on every free node.
+        self.kick_q.fill(0.0);
+        for i in 0..b.n {
+            let mu = mass[i] * kick[i % d];
+            for (q, p) in self.kick_q.iter_mut().zip(&b.phi[i * b.r..(i + 1) * b.r]) {
+                *q += p * mu;
+            }
+        }
+        for i in 0..b.n {
+            let held: f64 = b.phi[i * b.r..(i + 1) * b.r].iter().zip(&self.kick_q).map(|(p, q)| p * q).sum();
+            self.error.v[i] -= kick[i % d] - held;
+        }
+    }
+
+    /// On a return to `basis`: the error carried plus the part of the state
+    /// the basis leaves out (`left`, `left_rate` over the free DOFs) become
+    /// the error model's state beside it.
+    pub(super) fn carry_error(&mut self, basis: &ModalBasis, left: &[f64], left_rate: &[f64]) {
+        match &mut self.model {
+            Estimator::Full(_) => {
+                self.error.e.iter_mut().zip(left).for_each(|(e, l)| *e += l);
+                self.error.v.iter_mut().zip(left_rate).for_each(|(e, l)| *e += l);
+                self.error.a.fill(0.0);
+            }
+            Estimator::Directions(old) => {
+                let (mut e, mut v) = old.error_of(&self.error);
+                e.iter_mut().zip(left).for_each(|(e, l)| *e += l);
+                v.iter_mut().zip(left_rate).for_each(|(e, l)| *e += l);
+                let set = self.chosen.error_set.as_ref().expect("a direction model has a spring set");
+                let model = Estimator::directions(self.full.space.scene(), &self.chosen, basis, set);
+                self.error = ErrorState::zero(model.directions());
+                model.add(&mut self.error, &e, &v);
+                self.model = Estimator::Directions(model);
+            }
+        }
+        self.spare_error = self.error.clone();
+    }
+}
