@@ -27,6 +27,12 @@
 //!   correction, `anchorMotion`: the constraint modes in the basis) and full
 //!   space, the force and torque of every holder read after each step.
 //!
+//! - `adaptive/cloth-3d-NxN`: a whole run of 0.6 s in 0.01 s calls of
+//!   `fmi3DoStep` from the state after set-up (restored before each run,
+//!   untimed), default settings otherwise: full space, the best fixed
+//!   reduced setting (16 trained vectors, cubature forces on 100 x 100, exact
+//!   on 30 x 30), and `reduction = adaptive` (its set-up excluded).
+//!
 //! cargo bench --bench step
 
 use std::ffi::CString;
@@ -324,9 +330,45 @@ fn trained(c: &mut Criterion) {
     }
 }
 
+/// A run of 0.6 s through `fmi3DoStep` from set-up: full space, a fixed
+/// trained basis and the adaptive reduction (see the module documentation).
+fn adaptive(c: &mut Criterion) {
+    for n in [30u64, 100] {
+        let mut group = c.benchmark_group(format!("adaptive/cloth-3d-{n}x{n}"));
+        group.sample_size(10);
+        let fixed_force = if n == 100 { 2 } else { 1 };
+        let cases: [(&str, Vec<(u32, i64)>); 3] = [
+            ("full space", vec![(vr::REDUCTION, 2)]),
+            ("trained, 16 vectors", vec![(vr::MODE_SELECTION, 3), (vr::FORCE_EVALUATION, fixed_force)]),
+            ("adaptive", vec![(vr::REDUCTION, 3)]),
+        ];
+        for (label, choices) in cases {
+            let inst = cloth_with(n, &choices, false, 0.9);
+            let mut start: fmi3FMUState = null_mut();
+            assert_eq!(unsafe { fmi3GetFMUState(inst, &mut start) }, fmi3Status_fmi3OK);
+            group.bench_function(label, |b| {
+                b.iter_custom(|iters| {
+                    let mut total = Duration::ZERO;
+                    for _ in 0..iters {
+                        assert_eq!(unsafe { fmi3SetFMUState(inst, start) }, fmi3Status_fmi3OK);
+                        let mut time = 0.0;
+                        total += steps(inst, 60, 0.01, &mut time, None);
+                    }
+                    total
+                })
+            });
+            unsafe {
+                fmi3FreeFMUState(inst, &mut start);
+                fmi3FreeInstance(inst);
+            }
+        }
+        group.finish();
+    }
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(2));
-    targets = do_step, internal_step, cubature, residual_check, trained, holders
+    targets = do_step, internal_step, cubature, residual_check, trained, holders, adaptive
 }
 criterion_main!(benches);

@@ -52,6 +52,8 @@ fn main() {
         let t0 = Instant::now();
         let mut m = ad.simulator().unwrap();
         let setup = t0.elapsed().as_secs_f64();
+        let st = m.reduction_status();
+        println!("{name:10} basis {} error directions {} cubature springs {}", st.basis_size, st.error_directions, m.cubature_springs());
         let x0 = f.positions().to_vec();
         // A tenth of the sheet's weight on the load node, sideways and out of the plane: no program has it.
         let p = if name == "point" { [0.1 * weight, 0.0, 0.1 * weight] } else { [0.0; 3] };

@@ -93,10 +93,29 @@ fn do_step_allocates_nothing() {
 /// modal space for the grown basis, does.
 #[test]
 fn adaptive_steps_allocate_nothing() {
-    for integrator in [Integrator::NewmarkExplicit, Integrator::NewmarkImplicit, Integrator::Trigonometric] {
-        let mut setup = canonical_scenes::canonical("paper-2d-top-row").unwrap().with_settings(Settings::new(Reduction::Adaptive, integrator, 4));
+    // Exact forces with each scheme (the error model in full space), and cubature forces (in error directions).
+    let cases = [
+        (Integrator::NewmarkExplicit, ForceEvaluation::Exact),
+        (Integrator::NewmarkImplicit, ForceEvaluation::Exact),
+        (Integrator::Trigonometric, ForceEvaluation::Exact),
+        (Integrator::NewmarkExplicit, ForceEvaluation::Cubature),
+    ];
+    for (integrator, force_evaluation) in cases {
+        let settings = Settings { force_evaluation, ..Settings::new(Reduction::Adaptive, integrator, 4) };
+        // Cubature on cloth 30 x 30 at a tolerance of 0.05 (12 vectors and 15 error directions, set up in a second).
+        let scene = if force_evaluation == ForceEvaluation::Cubature {
+            canonical_scenes::cloth(30, 30)
+        } else {
+            canonical_scenes::canonical("paper-2d-top-row").unwrap()
+        };
+        let mut setup = scene.with_settings(Settings {
+            error_tolerance: if force_evaluation == ForceEvaluation::Cubature { 0.05 } else { settings.error_tolerance },
+            ..settings
+        });
         setup.loads.damping_beta = 1e-3;
         let mut sim = setup.simulator().unwrap_or_else(|e| panic!("{integrator:?}: {e}"));
+        let directions = sim.reduction_status().error_directions;
+        assert_eq!(directions > 0, force_evaluation == ForceEvaluation::Cubature, "{integrator:?}, {force_evaluation:?}: {directions} error directions");
         sim.do_step(0.01).unwrap();
         let mut loads = sim.loads().clone();
         let read = |sim: &mut Simulator| {

@@ -115,11 +115,18 @@ impl Model for MassSpring {
             Ok(sim) => {
                 log.log(OK, &format!("simulator set up: {} nodes in {}D, {} modes", sim.scene().n_nodes, sim.scene().dim, sim.mode_frequencies().len()));
                 if sim.settings().reduction == crate::options::Reduction::Adaptive {
+                    let status = sim.reduction_status();
+                    let (springs, all) = (sim.cubature_springs(), sim.scene().springs.len());
+                    let forces = if springs < all { format!("cubature forces ({springs} of {all} springs)") } else { "exact forces".to_string() };
+                    let model = match status.error_directions {
+                        0 => "the error model in full space".to_string(),
+                        k => format!("the error model in {k} directions beyond the basis, on a cubature"),
+                    };
                     log.log(
                         OK,
                         &format!(
-                            "reduction = adaptive: a trained basis of {} vectors chosen for errorTolerance = {} (its held-out snapshots' projection error within a quarter of it), exact forces",
-                            sim.reduction_status().basis_size,
+                            "reduction = adaptive: a trained basis of {} vectors chosen for errorTolerance = {} (its held-out snapshots' projection error within a quarter of it), {forces}, {model}",
+                            status.basis_size,
                             sim.settings().error_tolerance
                         ),
                     );

@@ -95,9 +95,12 @@ pub struct DirectionModel {
     /// Ψ, row-major n x k.
     psi: Vec<f64>,
     k: usize,
-    /// The spring set: scene index and weight of each spring.
+    /// The spring set: scene index and weight of each spring, and its G_e (D x k each).
     springs: Vec<usize>,
     weights: Vec<f64>,
+    gs: Vec<f64>,
+    /// The sampled springs' end positions (D values each, a then b).
+    ends: Vec<f64>,
     /// c, and Ψᵀ M e_axis for each axis.
     offset: Vec<f64>,
     mass_axis: Vec<f64>,
@@ -138,6 +141,8 @@ impl DirectionModel {
             k,
             springs: set.springs.clone(),
             weights: set.weights.clone(),
+            gs: Vec::new(),
+            ends: vec![0.0; 2 * d * set.springs.len()],
             offset: vec![0.0; k],
             mass_axis,
             c: vec![0.0; k * k],
@@ -151,16 +156,39 @@ impl DirectionModel {
         // c = Ψᵀ f_springs(x*) − Σ_S w G_eᵀ g_e(x*).
         let mut exact = vec![0.0; k];
         for e in 0..scene.springs.len() {
-            model.add_spring(scene, point, e, 1.0, &mut exact, false);
+            model.add_spring(scene, point, e, 1.0, &mut exact);
         }
         let mut sampled = vec![0.0; k];
         for (&e, &w) in set.springs.iter().zip(&set.weights) {
-            model.add_spring(scene, point, e, w, &mut sampled, false);
+            model.add_spring(scene, point, e, w, &mut sampled);
         }
         for ((o, a), b) in model.offset.iter_mut().zip(&exact).zip(&sampled) {
             *o = a - b;
         }
+        let mut gs = Vec::with_capacity(set.springs.len() * d * k);
+        for &e in &set.springs {
+            model.fill_g(scene, e);
+            gs.extend_from_slice(&model.g[..d * k]);
+        }
+        model.gs = gs;
         model
+    }
+
+    /// G_e = Ψ_a − Ψ_b of spring `e` into `self.g` (row i for coordinate i; zero at a held end).
+    fn fill_g(&mut self, scene: &Scene, e: usize) {
+        let (d, k, s) = (self.dim, self.k, &scene.springs[e]);
+        let n_free = self.n / d;
+        let g = &mut self.g[..d * k];
+        g.fill(0.0);
+        for (slot, sign) in [(s.a, 1.0), (s.b, -1.0)] {
+            if slot < n_free {
+                for i in 0..d {
+                    for (gj, p) in g[i * k..(i + 1) * k].iter_mut().zip(&self.psi[(slot * d + i) * k..(slot * d + i + 1) * k]) {
+                        *gj += sign * p;
+                    }
+                }
+            }
+        }
     }
 
     /// The number of error directions k.
@@ -168,69 +196,96 @@ impl DirectionModel {
         self.k
     }
 
-    /// out += w G_eᵀ g_e(x_b − x_a) for spring `e` at slot positions `x`, and
-    /// with `tangent` C += w G_eᵀ K_e G_e.
-    fn add_spring(&mut self, scene: &Scene, x: &[f64], e: usize, w: f64, out: &mut [f64], tangent: bool) {
-        match self.dim {
-            2 => self.add_spring_d::<2>(scene, x, e, w, out, tangent),
-            _ => self.add_spring_d::<3>(scene, x, e, w, out, tangent),
+    /// out += w G_eᵀ g_e(x_b − x_a) for spring `e` at slot positions `x` (set-up).
+    fn add_spring(&mut self, scene: &Scene, x: &[f64], e: usize, w: f64, out: &mut [f64]) {
+        self.fill_g(scene, e);
+        let (d, k, s) = (self.dim, self.k, &scene.springs[e]);
+        let dv: Vec<f64> = (0..d).map(|i| x[s.b * d + i] - x[s.a * d + i]).collect();
+        let pulled = match d {
+            2 => pull::<2>(&[dv[0], dv[1]], s.k, s.rest).to_vec(),
+            _ => pull::<3>(&[dv[0], dv[1], dv[2]], s.k, s.rest).to_vec(),
+        };
+        for i in 0..d {
+            for (o, gj) in out.iter_mut().zip(&self.g[i * k..(i + 1) * k]) {
+                *o += w * gj * pulled[i];
+            }
         }
     }
 
-    fn add_spring_d<const D: usize>(&mut self, scene: &Scene, x: &[f64], e: usize, w: f64, out: &mut [f64], tangent: bool) {
-        let (k, s) = (self.k, &scene.springs[e]);
-        let n_free = self.n / D;
-        // G = Ψ_a − Ψ_b, row i of the D rows for coordinate i.
-        let g = &mut self.g[..D * k];
-        g.fill(0.0);
-        for (slot, sign) in [(s.a, 1.0), (s.b, -1.0)] {
-            if slot < n_free {
+    /// Ψᵀ f_springs − c and C over the spring set at the end positions in `self.ends`.
+    fn sampled<const D: usize>(&mut self, scene: &Scene, forcing: &mut [f64]) {
+        let k = self.k;
+        for (((&e, &w), g), ends) in self.springs.iter().zip(&self.weights).zip(self.gs.chunks_exact(D * k)).zip(self.ends.chunks_exact(2 * D)) {
+            let s = &scene.springs[e];
+            let dv: [f64; D] = std::array::from_fn(|i| ends[D + i] - ends[i]);
+            let pulled = pull(&dv, s.k, s.rest);
+            for i in 0..D {
+                let wp = w * pulled[i];
+                for (o, gj) in forcing.iter_mut().zip(&g[i * k..(i + 1) * k]) {
+                    *o += gj * wp;
+                }
+            }
+            let l = dv.iter().map(|c| c * c).sum::<f64>().sqrt();
+            let ke = block::<D>(&dv, s.k, s.rest.min(l));
+            let kg = &mut self.kg[..D * k];
+            for i in 0..D {
+                for j in 0..k {
+                    kg[i * k + j] = w * (0..D).map(|m| ke[(i, m)] * g[m * k + j]).sum::<f64>();
+                }
+            }
+            for b in 0..k {
+                let column = &mut self.c[b * k..b * k + b + 1];
                 for i in 0..D {
-                    for (gj, p) in g[i * k..(i + 1) * k].iter_mut().zip(&self.psi[(slot * D + i) * k..(slot * D + i + 1) * k]) {
-                        *gj += sign * p;
+                    let kgib = kg[i * k + b];
+                    for (c, gia) in column.iter_mut().zip(&g[i * k..i * k + b + 1]) {
+                        *c += gia * kgib;
                     }
                 }
             }
         }
-        let dv: [f64; D] = std::array::from_fn(|i| x[s.b * D + i] - x[s.a * D + i]);
-        let pulled = pull(&dv, s.k, s.rest);
-        for i in 0..D {
-            for (o, gj) in out.iter_mut().zip(&g[i * k..(i + 1) * k]) {
-                *o += w * gj * pulled[i];
-            }
+    }
+
+    /// The sampled springs' ends at slot positions `x`.
+    pub fn ends_at(&mut self, scene: &Scene, x: &[f64]) {
+        let d = self.dim;
+        for (&e, ends) in self.springs.iter().zip(self.ends.chunks_exact_mut(2 * d)) {
+            let s = &scene.springs[e];
+            ends[..d].copy_from_slice(&x[s.a * d..(s.a + 1) * d]);
+            ends[d..].copy_from_slice(&x[s.b * d..(s.b + 1) * d]);
         }
-        if !tangent {
-            return;
-        }
-        let l = dv.iter().map(|c| c * c).sum::<f64>().sqrt();
-        let ke = block::<D>(&dv, s.k, s.rest.min(l));
-        let kg = &mut self.kg[..D * k];
-        for i in 0..D {
-            for j in 0..k {
-                kg[i * k + j] = (0..D).map(|m| ke[(i, m)] * g[m * k + j]).sum();
-            }
-        }
-        for b in 0..k {
-            for a in 0..=b {
-                let v: f64 = (0..D).map(|i| g[i * k + a] * kg[i * k + b]).sum();
-                self.c[b * k + a] += w * v;
+    }
+
+    /// The sampled springs' ends at x = x* + Φ q (a free end, `basis` and
+    /// `point` the slot positions x*) or where `slots` has them (a held end),
+    /// without expanding x: |S| 2 D r operations.
+    pub fn ends_modal(&mut self, scene: &Scene, basis: &ModalBasis, point: &[f64], q: &[f64], slots: &[f64]) {
+        let (d, r) = (self.dim, basis.r);
+        let n_free = self.n / d;
+        for (&e, ends) in self.springs.iter().zip(self.ends.chunks_exact_mut(2 * d)) {
+            let s = &scene.springs[e];
+            for (end, slot) in [(0, s.a), (1, s.b)] {
+                for i in 0..d {
+                    let dof = slot * d + i;
+                    ends[end * d + i] =
+                        if slot < n_free { point[dof] + basis.phi[dof * r..(dof + 1) * r].iter().zip(q).map(|(p, q)| p * q).sum::<f64>() } else { slots[dof] };
+                }
             }
         }
     }
 
-    /// C and Ψᵀ r at slot positions `x` under `gravity` and the point
-    /// force `point` (its first DOF and value), or C alone (r = 0: the run
-    /// is in full space, which adds no error).
-    pub fn linearize(&mut self, scene: &Scene, x: &[f64], loads: Option<(&[f64; 3], Option<(usize, &[f64])>)>) {
+    /// C and Ψᵀ r at the ends of the last [`Self::ends_at`] or
+    /// [`Self::ends_modal`] under `gravity` and the point force `point` (its
+    /// first DOF and value), or C alone (r = 0: the run is in full space,
+    /// which adds no error).
+    pub fn linearize(&mut self, scene: &Scene, loads: Option<(&[f64; 3], Option<(usize, &[f64])>)>) {
         let k = self.k;
         self.c.fill(0.0);
         let mut forcing = std::mem::take(&mut self.forcing);
         forcing.fill(0.0);
-        let (springs, weights) = (std::mem::take(&mut self.springs), std::mem::take(&mut self.weights));
-        for (&e, &w) in springs.iter().zip(&weights) {
-            self.add_spring(scene, x, e, w, &mut forcing, true);
+        match self.dim {
+            2 => self.sampled::<2>(scene, &mut forcing),
+            _ => self.sampled::<3>(scene, &mut forcing),
         }
-        (self.springs, self.weights) = (springs, weights);
         for b in 0..k {
             for a in 0..b {
                 self.c[a * k + b] = self.c[b * k + a];

@@ -35,7 +35,7 @@ use crate::physics::run::space::basis_bound;
 use crate::physics::run::state::Loads;
 use crate::physics::settings::{ForceEvaluation, Linearization, ModeSelection, Settings};
 use crate::physics::setup::basis;
-use crate::physics::setup::cubature_training::{self, MAX_MODES as MAX_CUBATURE_MODES};
+use crate::physics::setup::cubature_training;
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
 use crate::physics::setup::setup_data::{SetupData, SpringSet};
@@ -88,6 +88,11 @@ pub const CUBATURE_SPRINGS_PER_VECTOR: usize = 20;
 /// springs per vector, and a reduced step with exact forces visits every
 /// spring, as a full-space step does.
 pub const CUBATURE_PAYS: usize = 1000;
+/// Cubature forces only where the basis and the error directions together
+/// hold at most this many vectors: training their cubature costs about
+/// rows x springs² with 96 rows per vector (4 s for 33 vectors on cloth
+/// 100 x 100; minutes for 50 on cloth 40 x 40).
+pub const JOINT_CUBATURE_MODES: usize = 40;
 
 /// The held-out projection error P(j) for j = 0 ..= components of `train`
 /// (see the module documentation), and the components.
@@ -145,7 +150,7 @@ pub fn choose(scene: &Scene, loads: &Loads, settings: &Settings) -> Result<Chose
     // per vector), at the tolerance's accuracy, for the basis and the error directions.
     let per_vector = scene.springs.len() / size.max(1);
     let cubature = (per_vector >= CUBATURE_PAYS || settings.force_evaluation == ForceEvaluation::Cubature && per_vector >= CUBATURE_SPRINGS_PER_VECTOR)
-        && size + error_directions.len() <= MAX_CUBATURE_MODES;
+        && size + error_directions.len() <= JOINT_CUBATURE_MODES;
     let sized = Settings {
         n_modes: size,
         force_evaluation: if cubature { ForceEvaluation::Cubature } else { ForceEvaluation::Exact },

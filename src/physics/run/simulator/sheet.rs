@@ -145,6 +145,8 @@ pub struct ReductionStatus {
     pub error_estimate: f64,
     pub reduced_fraction: f64,
     pub basis_size: usize,
+    /// The error model's directions (an adaptive run with cubature forces), 0 where it works in full space or there is none.
+    pub error_directions: usize,
 }
 
 /// A run: everything [`super::Simulator`] offers.

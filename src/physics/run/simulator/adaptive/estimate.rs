@@ -7,7 +7,7 @@ use crate::physics::run::error_model::ErrorState;
 use crate::physics::run::integrator::Scheme;
 use crate::physics::run::simulator::estimators::Estimator;
 use crate::physics::run::simulator::Steps;
-use crate::physics::run::space::{Constants, Readout, ReducedForce};
+use crate::physics::run::space::{Constants, Readout, ReducedForce, Space};
 use crate::physics::setup::modes::ModalBasis;
 
 impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
@@ -42,20 +42,27 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             Estimator::Directions(model) => {
                 if self.in_full {
                     let x = self.full.space.positions(&self.full.state.y, &mut self.full.work);
-                    model.linearize(self.full.space.scene(), x, None);
+                    model.ends_at(self.full.space.scene(), x);
+                    model.linearize(self.full.space.scene(), None);
                 } else {
                     let felt = self.reduced.felt_loads();
-                    let scene = self.reduced.space.scene();
+                    let space = &self.reduced.space;
+                    let scene = space.scene();
                     let point = self.reduced.work.as_ref().point_force_as(&felt.point_load, scene).map(|(dof, f)| {
                         let mut p = [0.0; 3];
                         p[..f.len()].copy_from_slice(f);
                         (dof, p, f.len())
                     });
-                    let x = self.reduced.space.positions(&self.reduced.state.y, &mut self.reduced.work);
-                    motion = Some(slot_motion(x, &self.start, &self.slot_mass, d));
+                    // The sampled springs' ends and the motion from q, without expanding x.
+                    let q = &self.reduced.state.y;
+                    let slots = space.slots_mut(&mut self.reduced.work);
+                    model.ends_modal(scene, space.basis(), &space.modes().point, q, slots);
+                    let n = space.basis().n;
+                    let free: f64 = q.iter().zip(&self.motion_reference).map(|(q, b)| q * q + 2.0 * q * b).sum::<f64>() + self.motion_offset;
+                    let held = slot_motion(&slots[n..], &self.start[n..], &self.slot_mass[n / d..], d);
+                    motion = Some(free.max(0.0) + held);
                     let point = point.as_ref().map(|(dof, p, d)| (*dof, &p[..*d]));
-                    model.linearize(self.reduced.space.scene(), x, Some((&felt.gravity, point)));
-                    self.reduced.current = false;
+                    model.linearize(scene, Some((&felt.gravity, point)));
                 }
                 model.advance(&mut self.error, self.since)?;
             }

@@ -114,9 +114,13 @@ pub struct Adaptive<F: ReducedForce, R: Scheme, X: Scheme> {
     /// ‖e‖²_M and Σ m |x − x0|² at the last estimate, which stand for the steps until the next.
     last_error_sq: f64,
     last_motion_sq: f64,
-    /// Slot positions at the start and each slot's mass, for the motion.
+    /// Slot positions at the start and each slot's mass, for the motion;
+    /// Φᵀ M (x* − x0) and ‖x* − x0‖²_M over the free DOFs, for the motion of
+    /// a reduced state, ‖Φ q + x* − x0‖²_M = |q|² + 2 qᵀ Φᵀ M (x* − x0) + ‖x* − x0‖²_M.
     start: Vec<f64>,
     slot_mass: Vec<f64>,
+    motion_reference: Vec<f64>,
+    motion_offset: f64,
     /// The stretch in full space: its poses (displacements from x*), its length and the length it should reach.
     seen: Vec<Vec<f64>>,
     seen_count: usize,
@@ -187,6 +191,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             last_motion_sq: 0.0,
             start: Vec::new(),
             slot_mass,
+            motion_reference: Vec::new(),
+            motion_offset: 0.0,
             seen: vec![vec![0.0; n]; KEPT_POSES],
             seen_count: 0,
             seen_next: 0,
@@ -206,6 +212,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             chosen,
         };
         run.start = run.reduced.space.positions(&run.reduced.state.y, &mut run.reduced.work).to_vec();
+        run.reduced.current = false;
+        run.set_motion_reference();
         run.rewind = run.reduced.state.clone();
         run.kick_q = vec![0.0; run.reduced.space.basis().r];
         run.report_basis();
@@ -268,6 +276,17 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
                 *c += p * mu;
             }
         }
+    }
+
+    /// Φᵀ M (x* − x0) and ‖x* − x0‖²_M of the reduced run's basis (after set-up and each new basis).
+    fn set_motion_reference(&mut self) {
+        let (b, point) = (self.reduced.space.basis(), &self.reduced.space.modes().point);
+        let mass = &self.reduced.space.scene().dof_mass;
+        let gap: Vec<f64> = (0..b.n).map(|i| point[i] - self.start[i]).collect();
+        let mut q = vec![0.0; b.r];
+        b.project_displacement(mass, &gap, &mut q);
+        self.motion_reference = q;
+        self.motion_offset = gap.iter().zip(mass).map(|(g, m)| m * g * g).sum();
     }
 
     /// Σ m |x − x0|² over every node at the active run's positions.
@@ -460,6 +479,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         self.reduced = reduced;
         self.kick_q = vec![0.0; self.reduced.space.basis().r];
         self.grown = grown;
+        self.set_motion_reference();
         self.in_full = false;
         self.stretch = 0;
         self.estimate_soon();

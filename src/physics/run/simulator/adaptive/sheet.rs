@@ -200,6 +200,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
             self.rewind = self.reduced.state.clone();
             self.kick_q = vec![0.0; self.reduced.space.basis().r];
             self.grown = part.grown.clone();
+            self.set_motion_reference();
             self.report_basis();
         }
         if let Some(model) = model {
@@ -314,6 +315,10 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> SetUp for Adaptive<F, R, X> {
             error_estimate: self.tally.estimate(),
             reduced_fraction: self.tally.reduced_fraction(),
             basis_size: if self.in_full { self.reduced.n_dofs() } else { self.reduced.space.basis().r },
+            error_directions: match &self.model {
+                Estimator::Directions(m) => m.directions(),
+                Estimator::Full(_) => 0,
+            },
         }
     }
 }
