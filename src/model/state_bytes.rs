@@ -6,7 +6,8 @@
 //! per holder 2 to 4 its displacement and rotation targets, damping,
 //! weights; then (format 8) whether an adaptive part follows and the part:
 //! the mode, e, e', e'' of the error model, the estimate's sums, counts and
-//! schedule, the stretch's counters, its poses and the grown vectors.
+//! schedule, the stretch's counters, its poses, the grown vectors and where
+//! the error model was last linearized.
 //! Format 5 has no holders 2 to 4: they are at rest.
 
 use crate::bytes::{put_f64, put_f64s, put_u64, put_u8, Reader};
@@ -46,6 +47,7 @@ pub fn write(snap: &Snapshot, p: &mut Vec<u8>) {
         put_u64(p, list.len() as u64);
         list.iter().for_each(|v| put_f64s(p, v));
     }
+    put_f64s(p, &a.linearized);
 }
 
 /// A count of vectors, each at least 8 bytes long in what is left.
@@ -77,8 +79,8 @@ fn adaptive_part(r: &mut Reader) -> Result<Option<Box<AdaptivePart>>, String> {
     for c in counts.iter_mut().chain(&mut stretch) {
         *c = r.u64()?;
     }
-    let (seen, grown) = (vectors(r)?, vectors(r)?);
-    Ok(Some(Box::new(AdaptivePart { in_full, error, sums, counts, stretch, seen, grown })))
+    let (seen, grown, linearized) = (vectors(r)?, vectors(r)?, r.f64s()?);
+    Ok(Some(Box::new(AdaptivePart { in_full, error, sums, counts, stretch, seen, grown, linearized })))
 }
 
 fn vector(r: &mut Reader) -> Result<[f64; 3], String> {

@@ -87,6 +87,9 @@ pub fn error_directions(mass: &[f64], basis: &ModalBasis, candidates: &[Vec<f64>
     kept
 }
 
+/// Gravity, and the point force as its first DOF and value.
+pub type ExternalLoads<'a> = (&'a [f64; 3], Option<(usize, &'a [f64])>);
+
 /// The constant part of the model and its scratch.
 pub struct DirectionModel {
     dim: usize,
@@ -277,7 +280,7 @@ impl DirectionModel {
     /// [`Self::ends_modal`] under `gravity` and the point force `point` (its
     /// first DOF and value), or C alone (r = 0: the run is in full space,
     /// which adds no error).
-    pub fn linearize(&mut self, scene: &Scene, loads: Option<(&[f64; 3], Option<(usize, &[f64])>)>) {
+    pub fn linearize(&mut self, scene: &Scene, loads: Option<ExternalLoads>) {
         let k = self.k;
         self.c.fill(0.0);
         let mut forcing = std::mem::take(&mut self.forcing);

@@ -80,6 +80,10 @@ pub struct ErrorModel {
     mass: Vec<f64>,
     pattern: StiffnessPattern,
     stiffness: Vec<f64>,
+    /// The stiffness given at set-up, and the slot positions of the last
+    /// [`Self::relinearize`] (empty: the set-up's stiffness holds).
+    initial: Vec<f64>,
+    at: Vec<f64>,
     symbolic: SymbolicCholesky<usize>,
     matrix: Vec<f64>,
     l_values: Vec<f64>,
@@ -94,7 +98,8 @@ const BETA: f64 = 0.25;
 impl ErrorModel {
     /// The model of a scene with masses `mass` (free DOFs) and stiffness
     /// `stiffness` on `pattern`: the symbolic analysis, and every buffer.
-    pub fn new(mass: &[f64], pattern: StiffnessPattern, stiffness: Vec<f64>) -> Result<Self, PhysicsError> {
+    /// `slot_values`: the length of the slot positions it is linearized at.
+    pub fn new(mass: &[f64], pattern: StiffnessPattern, stiffness: Vec<f64>, slot_values: usize) -> Result<Self, PhysicsError> {
         let n = mass.len();
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx);
         let symbolic = factorize_symbolic_cholesky(sym, Side::Upper, SymmetricOrdering::Amd, Default::default())
@@ -112,6 +117,8 @@ impl ErrorModel {
             rhs: vec![0.0; n],
             symbolic,
             pattern,
+            initial: stiffness.clone(),
+            at: Vec::with_capacity(slot_values),
             stiffness,
         })
     }
@@ -177,9 +184,27 @@ impl ErrorModel {
     /// compressed springs (which would make the linear model grow without
     /// bound); refactored at the next step.
     pub fn relinearize(&mut self, scene: &crate::physics::setup::scene::Scene, x: &[f64]) {
+        self.at.clear();
+        self.at.extend_from_slice(x);
         self.stiffness.fill(0.0);
         self.pattern.add_tangent_with(scene, x, 1.0, true, &mut self.stiffness);
         self.factored = f64::NAN;
+    }
+
+    /// Where the model was last linearized (slot positions; empty: at set-up).
+    pub fn linearized_at(&self) -> &[f64] {
+        &self.at
+    }
+
+    /// Linearized at `at` again (empty: the set-up's stiffness), as a run that was there.
+    pub fn linearize_as(&mut self, scene: &crate::physics::setup::scene::Scene, at: &[f64]) {
+        if at.is_empty() {
+            self.stiffness.copy_from_slice(&self.initial);
+            self.at.clear();
+            self.factored = f64::NAN;
+        } else {
+            self.relinearize(scene, at);
+        }
     }
 
     /// ‖e‖²_M.

@@ -333,6 +333,8 @@ pub struct AdaptivePart {
     pub seen: Vec<Vec<f64>>,
     /// The vectors the basis grew by, oldest first.
     pub grown: Vec<Vec<f64>>,
+    /// The slot positions the full-space error model was last linearized at (empty: at set-up, or none).
+    pub linearized: Vec<f64>,
 }
 
 impl AdaptivePart {
@@ -341,6 +343,6 @@ impl AdaptivePart {
     pub fn fits(&self, n: usize, error_len: usize) -> bool {
         self.seen.iter().chain(&self.grown).all(|v| v.len() == n)
             && self.error.iter().all(|v| v.len() == error_len)
-            && self.error.iter().chain(&self.seen).chain(&self.grown).flatten().chain(&self.sums).all(|x| x.is_finite())
+            && self.error.iter().chain(&self.seen).chain(&self.grown).flatten().chain(&self.sums).chain(&self.linearized).all(|x| x.is_finite())
     }
 }

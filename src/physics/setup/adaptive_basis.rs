@@ -27,6 +27,13 @@
 //! ([`basis::orthonormal_ritz`]). The trained vectors always stay; the
 //! vectors grown stay while the basis holds at most [`CAP_FACTOR`] times
 //! the size chosen at set-up, the oldest dropped first.
+//!
+//! **Forces.** Cubature forces where they pay ([`CUBATURE_PAYS`] springs
+//! per vector, or [`CUBATURE_SPRINGS_PER_VECTOR`] when asked for) and the
+//! basis with its error directions holds at most [`JOINT_CUBATURE_MODES`]
+//! vectors: one cubature is trained for the basis and the error directions
+//! together ([`error_cubature`]); it serves the error model
+//! ([`crate::physics::run::error_directions`]) and every grown basis.
 
 use crate::physics::error::PhysicsError;
 use crate::physics::run::error_directions::error_directions;

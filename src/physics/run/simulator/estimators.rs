@@ -22,7 +22,10 @@ impl Estimator {
     /// The model for `chosen` beside `basis`, and its zero state.
     pub fn new(scene: &Scene, chosen: &Chosen, basis: &ModalBasis) -> Result<(Self, ErrorState), PhysicsError> {
         Ok(match &chosen.error_set {
-            None => (Estimator::Full(ErrorModel::new(&scene.dof_mass, chosen.pattern.clone(), chosen.stiffness.clone())?), ErrorState::zero(scene.n_dofs())),
+            None => (
+                Estimator::Full(ErrorModel::new(&scene.dof_mass, chosen.pattern.clone(), chosen.stiffness.clone(), scene.rest.len())?),
+                ErrorState::zero(scene.n_dofs()),
+            ),
             Some(set) => {
                 let model = Self::directions(scene, chosen, basis, set);
                 let k = model.directions();

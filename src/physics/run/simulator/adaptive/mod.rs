@@ -506,10 +506,16 @@ fn reduced_run<F: ReducedForce, R: Scheme>(scene: &Scene, settings: &Settings, l
     Run::new(Modal::<F>::new(scene.clone(), &l, &s, Some(data))?, &s, &l)
 }
 
-/// Each slot's mass: a free node's, and for a held node that of the free nodes (the nodes of a grid all weigh the same).
+/// Each slot's mass in the motion: a free node's; for a held node that of
+/// the free nodes (the nodes of a grid all weigh the same); none for a slot
+/// that is no node (an auxiliary spring's point), as E counts the nodes only.
 fn slot_masses(scene: &Scene) -> Vec<f64> {
     let typical = scene.dof_mass.first().copied().unwrap_or(1.0);
-    (0..scene.slot_of_node.len()).map(|s| if s < scene.n_free { scene.dof_mass[s * scene.dim] } else { typical }).collect()
+    let mut mass = vec![0.0; scene.rest.len() / scene.dim];
+    for &s in &scene.slot_of_node {
+        mass[s] = if s < scene.n_free { scene.dof_mass[s * scene.dim] } else { typical };
+    }
+    mass
 }
 
 /// Σ m |x − x0|² over the slots of dimension `d`.

@@ -139,6 +139,10 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
             stretch: [self.stretch as u64, self.stretch_target as u64, self.seen_next as u64],
             seen: self.seen().to_vec(),
             grown: self.grown.clone(),
+            linearized: match &self.model {
+                Estimator::Full(m) => m.linearized_at().to_vec(),
+                Estimator::Directions(_) => Vec::new(),
+            },
         }));
         s
     }
@@ -184,7 +188,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
             Some(Estimator::Directions(m)) => m.directions(),
             _ => self.error.e.len(),
         };
-        if !part.fits(n, error_len) {
+        let slot_values = self.reduced.scene().rest.len();
+        if !part.fits(n, error_len) || !(part.linearized.is_empty() || part.linearized.len() == slot_values) {
             return refuse("its adaptive part does not fit this scene (corrupt or of another set-up)");
         }
         let inner = |weights: Vec<f64>| Snapshot { state: s.state.clone(), loads: Loads { mode_weights: weights, ..s.loads.clone() }, adaptive: None };
@@ -205,6 +210,9 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
         }
         if let Some(model) = model {
             self.model = model;
+        }
+        if let Estimator::Full(m) = &mut self.model {
+            m.linearize_as(self.reduced.scene(), &part.linearized);
         }
         self.in_full = part.in_full;
         let [e, v, a] = &part.error;
