@@ -42,13 +42,11 @@ use faer::linalg::cholesky::llt::solve::solve_in_place_with_conj;
 use faer::{Conj, MatMut, MatRef, Par};
 
 use crate::physics::error::PhysicsError;
-use crate::physics::run::error_model::ErrorState;
+use crate::physics::run::error_model::{ErrorState, BETA};
 use crate::physics::run::forces::{block, pull};
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
 use crate::physics::setup::setup_data::SpringSet;
-
-const BETA: f64 = 0.25;
 
 /// A candidate direction is kept if at least this share of it is left after
 /// removing its part in the basis and in the directions before it.
@@ -321,9 +319,7 @@ impl DirectionModel {
             return Ok(());
         }
         let cc = BETA * h * h;
-        for j in 0..k {
-            s.e[j] += h * s.v[j] + cc * s.a[j];
-        }
+        s.predict(h);
         for i in 0..k {
             self.rhs[i] = self.forcing[i] - (0..k).map(|j| self.c[j * k + i] * s.e[j]).sum::<f64>();
         }
@@ -344,12 +340,7 @@ impl DirectionModel {
             Par::Seq,
             stack,
         );
-        for j in 0..k {
-            let a = self.rhs[j];
-            s.e[j] += cc * a;
-            s.v[j] += 0.5 * h * (s.a[j] + a);
-            s.a[j] = a;
-        }
+        s.correct(h, &self.rhs);
         Ok(())
     }
 

@@ -73,6 +73,24 @@ impl ErrorState {
     pub fn is_finite(&self) -> bool {
         self.e.iter().chain(&self.v).chain(&self.a).all(|x| x.is_finite())
     }
+
+    /// The trapezoidal rule's predictor over `h`: e += h e' + h²/4 e''.
+    pub fn predict(&mut self, h: f64) {
+        let c = BETA * h * h;
+        for ((e, v), a) in self.e.iter_mut().zip(&self.v).zip(&self.a) {
+            *e += h * v + c * a;
+        }
+    }
+
+    /// Its corrector with the new e'' = `a`: e += h²/4 a, e' += h/2 (e'' + a), e'' = a.
+    pub fn correct(&mut self, h: f64, a: &[f64]) {
+        let c = BETA * h * h;
+        for (((e, v), old), new) in self.e.iter_mut().zip(&mut self.v).zip(&mut self.a).zip(a) {
+            *e += c * new;
+            *v += 0.5 * h * (*old + new);
+            *old = *new;
+        }
+    }
 }
 
 /// The constant part of the error model and its scratch.
@@ -93,7 +111,8 @@ pub struct ErrorModel {
     rhs: Vec<f64>,
 }
 
-const BETA: f64 = 0.25;
+/// Newmark's β of the trapezoidal rule.
+pub const BETA: f64 = 0.25;
 
 impl ErrorModel {
     /// The model of a scene with masses `mass` (free DOFs) and stiffness
@@ -152,11 +171,8 @@ impl ErrorModel {
     /// e' += h/2 (e'' + a), e'' = a.
     pub fn advance(&mut self, s: &mut ErrorState, h: f64, r: &[f64]) -> Result<(), PhysicsError> {
         self.factor(h)?;
-        let c = BETA * h * h;
         // The predictor into s.e; K times it into rhs.
-        for k in 0..s.e.len() {
-            s.e[k] += h * s.v[k] + c * s.a[k];
-        }
+        s.predict(h);
         self.pattern.sym_matvec(&self.stiffness, &s.e, &mut self.rhs);
         for (x, rk) in self.rhs.iter_mut().zip(r) {
             *x = rk - *x;
@@ -169,12 +185,7 @@ impl ErrorModel {
             Par::Seq,
             stack,
         );
-        for k in 0..n {
-            let a = self.rhs[k];
-            s.e[k] += c * a;
-            s.v[k] += 0.5 * h * (s.a[k] + a);
-            s.a[k] = a;
-        }
+        s.correct(h, &self.rhs);
         Ok(())
     }
 
