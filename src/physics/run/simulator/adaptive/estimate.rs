@@ -94,15 +94,11 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         if kick == [0.0; 3] || s.rotation != [0.0; 3] {
             return;
         }
-        let model = match &self.model {
-            Estimator::Directions(m) => {
-                // In the error directions, Ψᵀ M Φ = 0: the kick's part there is Ψᵀ M kick.
-                m.add_uniform_velocity(&mut self.error, &kick);
-                return;
-            }
-            Estimator::Full(m) => m,
-        };
-        let _ = model;
+        if let Estimator::Directions(m) = &self.model {
+            // In the error directions, Ψᵀ M Φ = 0: the kick's part there is Ψᵀ M kick.
+            m.add_uniform_velocity(&mut self.error, &kick);
+            return;
+        }
         let b = self.reduced.space.basis();
         let mass = &self.reduced.scene().dof_mass;
         // q = Φᵀ M u for u = Δc on every free node.

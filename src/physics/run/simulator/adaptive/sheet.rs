@@ -159,8 +159,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
         let n = self.reduced.scene().n_dofs();
         let [stretch, target, next] = part.stretch.map(|c| usize::try_from(c).unwrap_or(usize::MAX));
         let cap = (CAP_FACTOR * self.chosen.data.basis.r).min(n);
-        let structure_fits = part.seen.iter().chain(&part.grown).all(|v| v.len() == n);
-        if !structure_fits
+        // The poses and grown vectors first (a basis is built from them); the error's length depends on that basis.
+        if !part.seen.iter().chain(&part.grown).all(|v| v.len() == n)
             || part.seen.len() > KEPT_POSES
             || next >= KEPT_POSES
             || !(1..=LONGEST_STRETCH).contains(&target)
