@@ -5,7 +5,9 @@ variant, marker by integrator), error against the number of modes (explicit
 and trigonometric runs at the shortest and longest step, coloured by variant) and error against
 the largest forceResidual of each modal run (coloured by variant; Spearman's
 rank correlation in the title). force_residual.png: E against the largest and
-the mean forceResidual of the leave-out runs of every scene."""
+the mean forceResidual of the leave-out runs of every scene. adaptive_estimate.png:
+each adaptive run's errorEstimate against its E (over the window and over the
+whole run), with the bounds it is held to."""
 import csv
 import os
 import sys
@@ -72,9 +74,9 @@ for scene, rs in by_scene.items():
         series[(variant(r), r["integrator"])].append(r)
     order = {v: i for i, v in enumerate(["full"] + VARIANTS)}
     for (v, integ), pts in sorted(series.items(), key=lambda kv: (order.get(kv[0][0], 99), kv[0][1])):
-        marker = "s" if v == "full" else MARKER.get(integ, "o")
+        marker = "s" if v == "full" else "*" if v == "adaptive" else MARKER.get(integ, "o")
         a.loglog([f(p, "run_s_per_sim_s") for p in pts], [e(p) for p in pts], marker, color=colour(v),
-                 label=f"{v} {integ.replace('newmark-', '')}", alpha=0.75, markersize=5,
+                 label=f"{v} {integ.replace('newmark-', '')}", alpha=0.75, markersize=10 if v == "adaptive" else 5,
                  markerfacecolor="none" if integ == "newmark-implicit" else colour(v))
     modal = [r for r in rs if r["method"] == "modal" and r["integrator"] in ("newmark-explicit", "trigonometric")]
     steps = sorted({r["step_label"] for r in modal}, key=lambda s: float(s.split("/")[1]) if "/" in s else 0)
@@ -132,3 +134,29 @@ for ax, column, name in zip(axes, ["force_residual_max", "force_residual_mean"],
 fig.tight_layout()
 fig.savefig(f"{out}/force_residual.png", dpi=90)
 plt.close(fig)
+
+# The adaptive runs' estimate against E.
+adaptive = [r for rs in by_scene.values() for r in rs if r["method"] == "adaptive"]
+if adaptive:
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5.5))
+    for ax, (error, estimate, name) in zip(axes, [("error_window", "estimate_window", "over the window"),
+                                                  ("error", "error_estimate", "over the whole run")], strict=True):
+        pts = [(f(r, error), f(r, estimate), r) for r in adaptive if f(r, error) > 0 and f(r, estimate) > 0]
+        for i, scene in enumerate(sorted({r["scene"] for _, _, r in pts})):
+            sp = [(x, y) for x, y, r in pts if r["scene"] == scene]
+            ax.loglog([x for x, _ in sp], [y for _, y in sp], "o", color=cmap[i % len(cmap)], label=scene, markersize=6)
+        if pts:
+            lo = min(min(x, y) for x, y, _ in pts) / 3
+            hi = max(max(x, y) for x, y, _ in pts) * 3
+            line = np.array([lo, hi])
+            ax.loglog(line, line, "k-", lw=0.8, label="estimate = E")
+            ax.loglog(line, line / 3, "k:", lw=0.8, label="E / 3 and 3 E")
+            ax.loglog(line, line * 3, "k:", lw=0.8)
+        ax.set_xlabel(f"E {name}")
+        ax.set_ylabel("errorEstimate at the same time")
+        ax.set_title(f"adaptive runs: estimate against E {name}")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(f"{out}/adaptive_estimate.png", dpi=90)
+    plt.close(fig)

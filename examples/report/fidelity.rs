@@ -10,7 +10,7 @@
 use modal_mass_spring::measures::{predictability, trajectory_errors_by_window, twin_offset, Masses};
 use modal_mass_spring::physics::*;
 
-use crate::plan::{full_solver, FRAME};
+use crate::plan::{full_solver, Change, FRAME};
 use crate::run::{run, set_up, simulate};
 
 /// Seeds of the twins' start displacements (fixed: the report is reproducible).
@@ -108,10 +108,10 @@ pub struct Twins {
 /// [`TWIN_STEP`], each free node of twin s moved [`TWIN_KICK`] in the
 /// direction [`TWIN_SEEDS`]\[s\] draws) against the same run undisturbed;
 /// `tick` after each run.
-pub fn twins(p: &Grid, seconds: f64, tick: &dyn Fn()) -> Twins {
+pub fn twins(p: &Grid, seconds: f64, change: Option<Change>, tick: &dyn Fn()) -> Twins {
     let t0 = std::time::Instant::now();
     let solver = full_solver(Integrator::NewmarkExplicit, TWIN_STEP);
-    let base = simulate(p, &solver, TWIN_STEP, seconds, f64::INFINITY, 1).expect("the twins' base run failed");
+    let base = simulate(p, &solver, TWIN_STEP, seconds, f64::INFINITY, 1, change).expect("the twins' base run failed");
     tick();
     let base_coarse = coarse(p, &base.frames, &base.readings);
     let mut by_window = Vec::new();
@@ -121,7 +121,7 @@ pub fn twins(p: &Grid, seconds: f64, tick: &dyn Fn()) -> Twins {
         let dy = twin_offset(prep.sim.n_dofs(), p.dim, TWIN_KICK, seed);
         prep.sim.displace(&dy).expect("a twin's start");
         prep.start = prep.sim.snapshot();
-        let twin = run(&mut prep, TWIN_STEP, seconds, f64::INFINITY, 1).expect("a twin's run failed");
+        let twin = run(&mut prep, TWIN_STEP, seconds, f64::INFINITY, 1, change).expect("a twin's run failed");
         // From the first output time after t = 0 (the twins start apart: E over t = 0 alone is 1e-7 / 0).
         by_window.push(trajectory_errors_by_window(&twin.frames[1..], &base.frames[1..], &base.frames[0], Masses::Equal));
         for (s, d) in spread.iter_mut().zip(deviation(&coarse(p, &twin.frames, &twin.readings), &base_coarse)) {

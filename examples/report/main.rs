@@ -31,6 +31,17 @@ use plan::{plan_scene, variants, SceneCase, LARGE_DOFS};
 use readme::{write_readme, Study};
 use row::{write_csv, Row};
 
+/// The canonical scene `name` with its gravity turned sideways mid-run
+/// ([`plan::TURN_AT_S`], [`plan::TURNED_GRAVITY`]): it leaves what its
+/// training program ran.
+fn turned(name: &str) -> SceneCase {
+    SceneCase {
+        label: format!("{name}-turned"),
+        params: canonical_scenes::canonical(name).unwrap().grid,
+        change: Some(plan::Change { at_s: plan::TURN_AT_S, gravity: plan::TURNED_GRAVITY }),
+    }
+}
+
 /// The command line.
 struct Args {
     quick: bool,
@@ -82,12 +93,16 @@ fn main() {
     let mut cases: Vec<SceneCase> = if quick {
         ["paper-2d-top-row", "paper-3d-sheet"]
             .into_iter()
-            .map(|n| SceneCase { label: n.into(), params: canonical_scenes::canonical(n).unwrap().grid })
+            .map(|n| SceneCase { label: n.into(), params: canonical_scenes::canonical(n).unwrap().grid, change: None })
+            .chain([turned("cloth-3d")])
             .collect()
     } else {
-        let mut c: Vec<SceneCase> =
-            canonical_scenes::names().into_iter().map(|n| SceneCase { label: n.into(), params: canonical_scenes::canonical(n).unwrap().grid }).collect();
-        c.push(SceneCase { label: "cloth-3d-100x100".into(), params: canonical_scenes::cloth(100, 100).grid });
+        let mut c: Vec<SceneCase> = canonical_scenes::names()
+            .into_iter()
+            .map(|n| SceneCase { label: n.into(), params: canonical_scenes::canonical(n).unwrap().grid, change: None })
+            .collect();
+        c.push(SceneCase { label: "cloth-3d-100x100".into(), params: canonical_scenes::cloth(100, 100).grid, change: None });
+        c.push(turned("cloth-3d"));
         c
     };
     if !only.is_empty() {
@@ -96,7 +111,7 @@ fn main() {
     std::fs::create_dir_all(&out).expect("cannot create the output folder");
 
     // Every way of running each scene.
-    let plans: Vec<Vec<plan::Plan>> = cases.iter().map(|case| plan_scene(&case.params, &variants, quick, variants_only)).collect();
+    let plans: Vec<Vec<plan::Plan>> = cases.iter().map(|case| plan_scene(&case.params, &variants, quick, variants_only, case.change.is_some())).collect();
     // Each scene's runs, its reference and its two checks, the twins' base run and the twins.
     let total: usize = plans.iter().map(|l| l.len() + 4 + fidelity::TWIN_SEEDS.len()).sum();
     let bar = ProgressBar::new(total as u64);

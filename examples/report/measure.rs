@@ -10,7 +10,7 @@ use modal_mass_spring::measures::{max_node_error, median, trajectory_error, traj
 use modal_mass_spring::physics::*;
 
 use crate::fidelity::{coarse, deviation, twins, Twins};
-use crate::plan::{full_solver, Plan, SceneCase, Variant, FRAME, REFERENCE_MARGIN};
+use crate::plan::{full_solver, method, variant_key, Plan, SceneCase, Variant, FRAME, REFERENCE_MARGIN};
 use crate::row::{describe, Row};
 use crate::run::{run, set_up, simulate, Prepared};
 
@@ -41,7 +41,8 @@ pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, referenc
     let p = &case.params;
     let n = p.build().unwrap().n_dofs();
     let reference_dt = reference_dt(n);
-    let reference_run = |dt: f64| simulate(p, &full_solver(Integrator::NewmarkExplicit, dt), dt, seconds, f64::INFINITY, 1);
+    let change = case.change;
+    let reference_run = |dt: f64| simulate(p, &full_solver(Integrator::NewmarkExplicit, dt), dt, seconds, f64::INFINITY, 1, change);
     bar.set_message(format!("{}: reference", case.label));
     let reference = reference_run(reference_dt).expect("reference run failed");
     bar.inc(1);
@@ -55,7 +56,7 @@ pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, referenc
     let self_error = *self_by_window.last().unwrap();
     let halved_error = trajectory_error(&halved.frames, &quartered.frames, &quartered.frames[0], Masses::Equal);
     bar.set_message(format!("{}: twins", case.label));
-    let twins = twins(p, seconds, &|| bar.inc(1));
+    let twins = twins(p, seconds, change, &|| bar.inc(1));
     let reference_coarse = coarse(p, &reference.frames, &reference.readings);
     let mut run_by_window: Vec<Vec<f64>> = Vec::new();
     let first = rows.len();
@@ -78,19 +79,22 @@ pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, referenc
         }
     }
     order.extend(groups.iter().flat_map(|(_, g)| g.iter().copied()));
+    // Adaptive runs last, each set up for itself (its set-up reads its step bound).
+    order.extend((0..list.len()).filter(|&i| list[i].solver.reduction == Reduction::Adaptive));
+    // Each adaptive run's estimates at the output times, by its index in `list`.
+    let mut estimates: Vec<(usize, Vec<f64>)> = Vec::new();
     let mut slots: Vec<Option<(Row, Vec<f64>)>> = (0..list.len()).map(|_| None).collect();
     let mut prepared: Option<(Configuration, Result<Prepared, PhysicsError>)> = None;
     for &i in &order {
         let plan = &list[i];
         let s = &plan.solver;
         let modal = s.reduction == Reduction::Modal;
-        let method = if modal { "modal" } else { "full" };
-        let variant = if modal { variants[plan.variant].key } else { "full" };
+        let (method, variant) = (method(s), variant_key(plan, variants));
         bar.set_message(format!("{}: {method} {variant} {} r={} step {}", case.label, s.integrator.name(), s.n_modes, plan.step_label));
         let result = if plan.note.starts_with("not run") {
             Err(plan.note.clone())
         } else if !modal {
-            simulate(p, s, plan.step, seconds, budget_s, repeats)
+            simulate(p, s, plan.step, seconds, budget_s, repeats, change)
         } else {
             let key = (s.integrator, s.n_modes, plan.variant);
             if prepared.as_ref().map(|(k, _)| *k) != Some(key) {
@@ -100,8 +104,8 @@ pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, referenc
                 prepared = Some((key, set_up(p, &Settings { max_internal_step: longest, ..s.clone() })));
             }
             match &mut prepared.as_mut().unwrap().1 {
-                Ok(prep) => run(prep, plan.step, seconds, budget_s, repeats),
-                Err(PhysicsError::ExplicitTooStiff { .. }) => simulate(p, s, plan.step, seconds, budget_s, repeats),
+                Ok(prep) => run(prep, plan.step, seconds, budget_s, repeats, change),
+                Err(PhysicsError::ExplicitTooStiff { .. }) => simulate(p, s, plan.step, seconds, budget_s, repeats, change),
                 Err(e) => Err(e.to_string()),
             }
         };
@@ -113,6 +117,11 @@ pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, referenc
             variant,
             integrator: s.integrator.name(),
             modes: if modal { s.n_modes } else { n },
+            error_tolerance: if s.reduction == Reduction::Adaptive { s.error_tolerance } else { f64::NAN },
+            error_estimate: f64::NAN,
+            estimate_window: f64::NAN,
+            reduced_fraction: f64::NAN,
+            basis_size_end: None,
             step: plan.step,
             step_label: plan.step_label.clone(),
             internal_steps: 0,
@@ -151,6 +160,13 @@ pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, referenc
                 row.force_residual_max = t.force_residual_max;
                 row.force_residual_mean = t.force_residual_mean;
                 row.springs_visited = t.springs_visited;
+                if s.reduction == Reduction::Adaptive {
+                    row.modes = t.setup_basis_size;
+                    row.error_estimate = *t.estimates.last().unwrap();
+                    row.reduced_fraction = t.reduced_fraction;
+                    row.basis_size_end = Some(t.basis_size);
+                    estimates.push((i, t.estimates));
+                }
                 row.stable = e.is_finite();
                 let d = deviation(&coarse(p, &t.frames, &t.readings), &reference_coarse);
                 [row.force_vs_twins, row.bottom_vs_twins, row.kinetic_vs_twins, row.potential_vs_twins] = std::array::from_fn(|o| d[o] / twins.spread[o]);
@@ -202,6 +218,9 @@ pub fn measure_scene(s: &Conditions, case: &SceneCase, list: Vec<Plan>, referenc
         row.error_resolved = w.get(resolved - 1).copied().unwrap_or(f64::NAN);
         row.window_s = window_s;
         row.error_window = w.get(window).copied().unwrap_or(f64::NAN);
+    }
+    for (i, e) in &estimates {
+        rows[first + i].estimate_window = e.get(window).copied().unwrap_or(f64::NAN);
     }
     let self_error_resolved = self_by_window[resolved - 1];
     let smallest = rows[first..].iter().filter(|r| r.stable).map(|r| r.error).fold(f64::INFINITY, f64::min);

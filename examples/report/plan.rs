@@ -68,6 +68,37 @@ pub fn variants() -> Vec<Variant> {
 pub struct SceneCase {
     pub label: String,
     pub params: Grid,
+    /// A load the scene turns to mid-run, outside what its training program ran.
+    pub change: Option<Change>,
+}
+
+/// Gravity set to `gravity` at time `at_s` (from the first co-simulation
+/// step that starts at or after it): a scene that leaves its program.
+#[derive(Clone, Copy)]
+pub struct Change {
+    pub at_s: f64,
+    pub gravity: [f64; 3],
+}
+
+/// When the scenes that leave their program turn their gravity [s].
+pub const TURN_AT_S: f64 = 0.25;
+/// The gravity they turn to: 9.81 m/s^2 in the sheet's plane, sideways.
+pub const TURNED_GRAVITY: [f64; 3] = [9.81, 0.0, 0.0];
+
+/// The error tolerances of the adaptive runs (the quick study's: the default only).
+pub const TOLERANCES: [f64; 3] = [0.003, 0.01, 0.03];
+/// The mode count an adaptive run reports its first vectors of (its basis is its own).
+pub const ADAPTIVE_REPORTED: usize = 2;
+
+/// The adaptive runs of a scene, as (step index, scheme, tolerance):
+/// explicit Newmark at steps 1/240 and 1/60 (quick: 1/240, the default tolerance).
+pub fn adaptive_grid(quick: bool) -> Vec<(usize, Integrator, f64)> {
+    let (steps, tolerances): (&[usize], &[f64]) = if quick { (&[1], &[0.01]) } else { (&[1, STEP_60], &TOLERANCES) };
+    tolerances.iter().flat_map(|&tol| steps.iter().map(move |&si| (si, Integrator::NewmarkExplicit, tol))).collect()
+}
+
+pub fn adaptive_solver(integrator: Integrator, error_tolerance: f64, max_internal_step: f64) -> Settings {
+    Settings { max_internal_step, error_tolerance, ..Settings::new(Reduction::Adaptive, integrator, ADAPTIVE_REPORTED) }
 }
 
 pub struct Plan {
@@ -162,8 +193,10 @@ fn modal_only(scene: &Scene, integrator: Integrator) -> bool {
 }
 
 /// Every way of running the scene `p` (`quick`: the CI's smaller grid;
-/// `variants_only`: without the paper's modal grid).
-pub fn plan_scene(p: &Grid, variants: &[Variant], quick: bool, variants_only: bool) -> Vec<Plan> {
+/// `variants_only`: without the paper's modal grid; a scene that leaves
+/// its program runs full space, the trained variants and adaptive only).
+pub fn plan_scene(p: &Grid, variants: &[Variant], quick: bool, variants_only: bool, leaves_program: bool) -> Vec<Plan> {
+    let variants_only = variants_only || leaves_program;
     let scene = p.build().unwrap();
     let n = scene.n_dofs();
     let mut mode_counts: Vec<usize> = std::iter::successors(Some(1usize), |r| Some(r * 2)).take_while(|&r| r < n).collect();
@@ -236,6 +269,9 @@ pub fn plan_scene(p: &Grid, variants: &[Variant], quick: bool, variants_only: bo
             }
         }
     }
+    if leaves_program {
+        variant_runs.retain(|&(_, _, _, v)| v == TRAINED || v == TRAINED_CUBATURE);
+    }
     for (si, integrator, r, v) in variant_runs {
         let (h, label) = STEPS[si];
         if r >= n {
@@ -246,5 +282,26 @@ pub fn plan_scene(p: &Grid, variants: &[Variant], quick: bool, variants_only: bo
         let note = tangent_note(integrator, springs, r);
         list.push(Plan { solver: modal_solver(integrator, r, h, &variants[v]), variant: v, step: h, step_label: label.into(), note });
     }
+    for (si, integrator, tol) in adaptive_grid(quick) {
+        let (h, label) = STEPS[si];
+        list.push(Plan { solver: adaptive_solver(integrator, tol, h), variant: PAPER, step: h, step_label: label.into(), note: String::new() });
+    }
     list
+}
+
+/// The run's method in the CSV.
+pub fn method(s: &Settings) -> &'static str {
+    match s.reduction {
+        Reduction::Full => "full",
+        Reduction::Modal => "modal",
+        Reduction::Adaptive => "adaptive",
+    }
+}
+
+/// The run's variant in the CSV ("full" and "adaptive" for those methods).
+pub fn variant_key(plan: &Plan, variants: &[Variant]) -> &'static str {
+    match plan.solver.reduction {
+        Reduction::Modal => variants[plan.variant].key,
+        _ => method(&plan.solver),
+    }
 }

@@ -71,6 +71,20 @@ pub struct Row {
     pub kinetic_vs_twins: f64,
     #[serde(serialize_with = "sci7")]
     pub potential_vs_twins: f64,
+    /// Adaptive runs (NaN or empty for the others): the error tolerance;
+    /// `errorEstimate` at the end of the run and at the end of the window
+    /// (the estimate of `error` and of `error_window`); the share of
+    /// internal steps taken reduced; the basis size at the end (`modes`:
+    /// at set-up; the free DOFs while in full space).
+    #[serde(serialize_with = "shortest")]
+    pub error_tolerance: f64,
+    #[serde(serialize_with = "sci7")]
+    pub error_estimate: f64,
+    #[serde(serialize_with = "sci7")]
+    pub estimate_window: f64,
+    #[serde(serialize_with = "sci7")]
+    pub reduced_fraction: f64,
+    pub basis_size_end: Option<usize>,
 }
 
 impl Row {
@@ -112,6 +126,8 @@ pub fn write_csv(out: &str, rows: &[Row]) -> Result<(), csv::Error> {
 pub fn describe(r: &Row) -> String {
     if r.method == "full" {
         format!("full {} step {}", r.integrator, r.step_label)
+    } else if r.method == "adaptive" {
+        format!("adaptive tol {} {} step {}", r.error_tolerance, r.integrator, r.step_label)
     } else {
         format!("modal {} {} r={} step {}", r.variant, r.integrator, r.modes, r.step_label)
     }

@@ -122,14 +122,23 @@ impl Model for MassSpring {
                         0 => "the error model in full space".to_string(),
                         k => format!("the error model in {k} directions beyond the basis, on a cubature"),
                     };
-                    log.log(
-                        OK,
-                        &format!(
-                            "reduction = adaptive: a trained basis of {} vectors chosen for errorTolerance = {} (its held-out snapshots' projection error within a quarter of it), {forces}, {model}",
-                            status.basis_size,
-                            sim.settings().error_tolerance
-                        ),
+                    let chosen = format!(
+                        "reduction = adaptive: a trained basis of {} vectors chosen for errorTolerance = {} (its held-out snapshots' projection error within a quarter of it)",
+                        status.chosen_size,
+                        sim.settings().error_tolerance
                     );
+                    if status.reduces {
+                        log.log(OK, &format!("{chosen}, {forces}, {model}"));
+                    } else {
+                        let n = sim.n_dofs();
+                        log.log(
+                            OK,
+                            &format!(
+                                "{chosen}; on {n} free DOFs a basis pays with at most one vector per {} of them: full space throughout",
+                                crate::physics::ADAPTIVE_DOFS_PER_VECTOR
+                            ),
+                        );
+                    }
                 }
                 self.installed(sim);
                 Ok(())

@@ -21,6 +21,7 @@ pub mod setup;
 pub use error::{HolderProblem, PhysicsError, Quantity, StepFailure};
 pub use run::integrator::EXPLICIT_SAFETY;
 pub use run::simulator::registry::Simulator;
+pub use run::simulator::ADAPTIVE_DOFS_PER_VECTOR;
 pub use run::simulator::{internal_step_count, Reads, ReductionStatus, SetUp, Sheet, Steps, MAX_INTERNAL_STEPS_PER_CALL, STEP_COUNT_TOLERANCE};
 pub use run::state::{AdaptivePart, Loads, Motion, Pose, Snapshot, State, OTHER_HOLDERS};
 pub use settings::{ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction, Settings, TrainingProgram};

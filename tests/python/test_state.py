@@ -277,6 +277,8 @@ def test_adaptive_state_resumes_in_either_mode(new_instance):
     def adaptive(name):
         inst = new_instance(name)
         inst.slave.setInt64([inst.vr["reduction"]], [3])
+        # 24 x 24 nodes: large enough for the chosen basis to pay (10 x 10 runs in full space throughout).
+        inst.slave.setUInt64([inst.vr["nx"], inst.vr["ny"]], [24, 24])
         inst.initialize()
         return inst
 

@@ -1,5 +1,6 @@
 //! The study's `README.md`, section by section.
 
+mod adaptive;
 mod scenes;
 mod tables;
 mod targets;
@@ -113,6 +114,7 @@ pub fn write_readme(out: &str, study: &Study, reference_notes: &str) {
     tables::integrators(&mut md, rows, &scenes);
     tables::variants(&mut md, rows, variants, &scenes);
     tables::force_residual(&mut md, rows, &scenes);
+    adaptive::section(&mut md, rows, &scenes);
     scenes::setup(&mut md, rows, variants, &scenes);
     scenes::per_scene(&mut md, rows, &scenes);
     let _ = writeln!(md, "All runs: `error_vs_runtime.csv`.");

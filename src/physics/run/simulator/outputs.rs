@@ -348,6 +348,8 @@ impl<S: Readout, I: Scheme> SetUp for Run<S, I> {
             error_estimate: 0.0,
             reduced_fraction: if kept.is_some() { 1.0 } else { 0.0 },
             basis_size: kept.unwrap_or(self.space.scene().n_dofs()),
+            chosen_size: kept.unwrap_or(self.space.scene().n_dofs()),
+            reduces: kept.is_some(),
             error_directions: 0,
         }
     }

@@ -145,6 +145,10 @@ pub struct ReductionStatus {
     pub error_estimate: f64,
     pub reduced_fraction: f64,
     pub basis_size: usize,
+    /// The basis size chosen at set-up, and whether the run reduces at all
+    /// (an adaptive run on a scene too small for its basis to pay runs in full space throughout).
+    pub chosen_size: usize,
+    pub reduces: bool,
     /// The error model's directions (an adaptive run with cubature forces), 0 where it works in full space or there is none.
     pub error_directions: usize,
 }

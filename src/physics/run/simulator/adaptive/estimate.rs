@@ -26,8 +26,11 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             _ if self.in_full && !carried => {}
             Estimator::Full(model) => {
                 if self.in_full {
-                    // At the tangent of the last estimate (factored already for the same gap).
+                    // At the tangent of the full-space state: a carried error
+                    // grows or shrinks as the trajectory's own sensitivity there says.
                     self.residual.fill(0.0);
+                    let x = self.full.space.positions(&self.full.state.y, &mut self.full.work);
+                    model.relinearize(self.full.space.scene(), x);
                 } else {
                     let felt = self.reduced.felt_loads();
                     let q = &self.reduced.state.y;

@@ -59,6 +59,14 @@ pub const ESTIMATE_SHARE: f64 = 0.25;
 pub const LONGEST_GAP: u64 = 32;
 /// The most poses of a stretch in full space kept for the basis to grow by.
 pub const KEPT_POSES: usize = 32;
+/// The reduced model pays where the chosen basis holds at most one vector
+/// per this many free DOFs; on a smaller scene the run is full space
+/// throughout. A reduced step expands and projects through the basis (2 n r
+/// flops each way, at least n²/8 beyond this) besides its force pass; a
+/// full-space step costs a pass over the springs, a few per DOF (measured
+/// in report/: on paper-2d-top-row, 180 DOFs and 34 vectors, a run with the
+/// estimate took 7x the full-space run's time at the same step).
+pub const DOFS_PER_VECTOR: usize = 16;
 
 /// What the estimate of E counts: sums over the communication points.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -96,6 +104,8 @@ pub struct Adaptive<F: ReducedForce, R: Scheme, X: Scheme> {
     reduced: Run<Modal<F>, R>,
     full: Run<Full, X>,
     in_full: bool,
+    /// The basis is small enough to pay ([`DOFS_PER_VECTOR`]): else full space throughout.
+    reduces: bool,
     chosen: Chosen,
     /// The vectors grown so far, oldest first.
     grown: Vec<Vec<f64>>,
@@ -176,6 +186,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             reduced,
             full,
             in_full: false,
+            reduces: n >= DOFS_PER_VECTOR * chosen.data.basis.r,
             grown: Vec::new(),
             model,
             spare_error: error.clone(),
@@ -216,6 +227,9 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         run.set_motion_reference();
         run.rewind = run.reduced.state.clone();
         run.kick_q = vec![0.0; run.reduced.space.basis().r];
+        if !run.reduces {
+            run.lift();
+        }
         run.report_basis();
         run.report_coordinates();
         Ok(run)
@@ -424,7 +438,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// Grows the basis from the stretch and returns to it if it holds the
     /// state; else the next stretch is twice as long (see the module documentation).
     fn try_return(&mut self) -> Result<(), PhysicsError> {
-        if self.outside_program() {
+        if !self.reduces || self.outside_program() {
             self.stretch = 0;
             return Ok(());
         }

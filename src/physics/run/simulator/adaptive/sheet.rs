@@ -323,6 +323,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> SetUp for Adaptive<F, R, X> {
             error_estimate: self.tally.estimate(),
             reduced_fraction: self.tally.reduced_fraction(),
             basis_size: if self.in_full { self.reduced.n_dofs() } else { self.reduced.space.basis().r },
+            chosen_size: self.chosen.data.basis.r,
+            reduces: self.reduces,
             error_directions: match &self.model {
                 Estimator::Directions(m) => m.directions(),
                 Estimator::Full(_) => 0,
