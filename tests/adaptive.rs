@@ -1,8 +1,9 @@
 //! reduction = adaptive (`docs/method.md`, section 10) on cloth 30 x 30,
 //! undamped, explicit, 0.01 s steps, over [0, 0.6 s] (inside the cloth's
-//! predictable window), against the full-space run under the same loads:
-//! the error it reaches, its estimate of it, the share of steps it takes
-//! reduced. `cargo test --release --test suite adaptive:: -- --nocapture` prints the table.
+//! predictable window), against a full-space reference under the same
+//! loads at an eighth of its stable step: the error it reaches (the
+//! reduction's and the step's), its estimate of it, the share of steps it
+//! takes reduced. `cargo test --release --test suite adaptive:: -- --nocapture` prints the table.
 
 use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::physics::*;
@@ -36,7 +37,9 @@ fn run_shaken(n: usize, g: [f64; 3], p: [f64; 3], amplitude: f64, tolerance: f64
     let mut base = canonical_scenes::cloth(n, n);
     base.loads.damping_alpha = 0.0;
     base.loads.damping_beta = 0.0;
-    let mut full = base.with_settings(Settings::new(Reduction::Full, Integrator::NewmarkExplicit, 0)).simulator().unwrap();
+    let stable = base.with_settings(Settings::new(Reduction::Full, Integrator::NewmarkExplicit, 0)).simulator().unwrap().max_stable_step();
+    let reference = Settings { max_internal_step: stable / 8.0, ..Settings::new(Reduction::Full, Integrator::NewmarkExplicit, 0) };
+    let mut full = base.with_settings(reference).simulator().unwrap();
     let adaptive = Settings { error_tolerance: tolerance, ..Settings::new(Reduction::Adaptive, Integrator::NewmarkExplicit, 2) };
     let mut sim = base.with_settings(adaptive).simulator().unwrap();
     let start = full.positions().to_vec();
@@ -88,7 +91,8 @@ fn gravity_outside_the_program_runs_in_full_space() {
         let o = run(g, [0.0; 3], tolerance);
         println!("{name}: E {:.4}, estimate {:.4}, reduced {:.3}", o.e, o.estimate, o.reduced);
         assert_eq!(o.reduced, 0.0, "{name}: a basis trained for other loads is not used");
-        assert_eq!(o.e, 0.0, "{name}: the full-space run itself");
+        assert!(o.e <= 2.0 * tolerance, "{name}: E = {}", o.e);
+        assert!(within_bounds(&o, tolerance), "{name}: estimate {} against E {} (full space's own step error)", o.estimate, o.e);
     }
 }
 

@@ -17,6 +17,9 @@ use crate::physics::run::state::State;
 pub struct NewmarkExplicit;
 
 impl Scheme for NewmarkExplicit {
+    /// β = 0: |1/12 − 0| / 2.
+    const FREQUENCY_ERROR: f64 = 1.0 / 24.0;
+
     /// EXPLICIT_SAFETY of the limit 2 / omega_max.
     fn stable_step(omega_sq_max: f64) -> Option<f64> {
         let omega = omega_sq_max.sqrt();

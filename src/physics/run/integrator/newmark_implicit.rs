@@ -24,6 +24,9 @@ pub const NEWTON_TOLERANCE: f64 = 1e-11;
 pub struct NewmarkImplicit;
 
 impl Scheme for NewmarkImplicit {
+    /// β = 1/4: |1/12 − 1/4| / 2.
+    const FREQUENCY_ERROR: f64 = 1.0 / 12.0;
+
     fn stable_step(_omega_sq_max: f64) -> Option<f64> {
         None
     }

@@ -23,6 +23,17 @@ pub trait Scheme: Send + 'static {
     /// Values per coordinate the scheme keeps in [`Buffers::scheme`].
     const SCRATCH: usize = 0;
 
+    /// The scheme's frequency error on a linear oscillator: its discrete
+    /// frequency is ω (1 ± c (ω h)²) to leading order, and this is c. For
+    /// Newmark with γ = 1/2 the three-level form reads
+    /// Δ²y = h² (a_n + β Δ²a_n), against Δ²y = h² (a_n + h² a''/12) of the
+    /// exact motion, so c = |1/12 − β| / 2: 1/24 for β = 0, 1/12 for β = 1/4.
+    /// A mode j then drifts in phase by c ω_j³ h² t, a displacement error
+    /// of c h² t ω_j² y'_j, which over every mode is e(t) ≈ c h² t |j(t)| with j = y⃛ the jerk
+    /// (the step error an adaptive run adds to its estimate). 0 where the
+    /// scheme is exact on the linear part (the trigonometric one).
+    const FREQUENCY_ERROR: f64;
+
     /// The scheme integrates forces that depend on the rates other than
     /// through the damping, as the Coriolis force of a turning holder does.
     const TURNS: bool = true;

@@ -76,12 +76,39 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             None => self.motion_sq(),
         };
         let w = self.wait as f64;
-        self.tally.error_sq += w * self.last_error_sq;
+        // The step error adds to the reduction's (independent of it, in square).
+        self.tally.error_sq += w * (self.last_error_sq + self.step_error_sq());
         self.tally.motion_sq += w * self.last_motion_sq;
         self.wait = 0;
         self.since = 0.0;
         self.gap = (2 * self.gap).min(self.period);
         Ok(())
+    }
+
+    /// ‖e_h‖²_M of the scheme's own step error at the state (see
+    /// [`Scheme::FREQUENCY_ERROR`]): e_h = c h_i² t j with h_i the internal
+    /// step, t the time since the start and j the jerk over the last
+    /// communication step, (a − a_start) / h: in full space with the mass
+    /// of each DOF, in the modal space as |j| (the basis is M-orthonormal).
+    /// Measured against full space at an eighth of the stable step (cloth 30 x 30,
+    /// 0.6 s, explicit and implicit, 1/240 s and 0.01 s, four loads): 1.1 to 2.5x
+    /// the step error of full space.
+    pub(super) fn step_error_sq(&self) -> f64 {
+        let (c, state, start, internal, mass) = if self.in_full {
+            (X::FREQUENCY_ERROR, &self.full.state, &self.full.backup, self.full.internal_steps_last, Some(&self.full.space.scene().dof_mass))
+        } else {
+            (R::FREQUENCY_ERROR, &self.reduced.state, &self.reduced.backup, self.reduced.internal_steps_last, None)
+        };
+        let h = state.time - start.time;
+        if c == 0.0 || !(h > 0.0) || internal == 0 {
+            return 0.0;
+        }
+        let jerk_sq: f64 = match mass {
+            Some(m) => state.a.iter().zip(&start.a).zip(m).map(|((a, b), m)| m * (a - b).powi(2)).sum::<f64>(),
+            None => state.a.iter().zip(&start.a).map(|(a, b)| (a - b).powi(2)).sum::<f64>(),
+        } / (h * h);
+        let hi = h / internal as f64;
+        (c * hi * hi * state.time).powi(2) * jerk_sq
     }
 
     /// The holder's translation changes its velocity at the start of a step

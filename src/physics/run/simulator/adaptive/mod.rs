@@ -66,7 +66,7 @@ pub const KEPT_POSES: usize = 32;
 /// full-space step costs a pass over the springs, a few per DOF (measured
 /// in report/: on paper-2d-top-row, 180 DOFs and 34 vectors, a run with the
 /// estimate took 7x the full-space run's time at the same step).
-pub const DOFS_PER_VECTOR: usize = 16;
+pub const DOFS_PER_VECTOR: usize = 32;
 
 /// What the estimate of E counts: sums over the communication points.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
