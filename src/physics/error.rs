@@ -121,6 +121,10 @@ pub enum Expected {
     /// At most this value in magnitude.
     #[error("finite and at most {0} in magnitude")]
     Within(f64),
+    /// 1: a mode weight of an adaptive run, which approximates the
+    /// unweighted physics on a basis of its own.
+    #[error("1 in an adaptive run (it approximates the unweighted physics on a basis it chooses; weights act in a modal run)")]
+    OneInAdaptive,
 }
 
 /// Why an internal step failed. The state is that of the start of the

@@ -201,3 +201,21 @@ def test_fixed_parameters_refused_in_step_mode(new_instance):
     for name in ("spacing", "nodeMass", "springStiffness"):
         with pytest.raises(FMICallException):
             inst.set_f64(name, [1.0])
+
+
+def test_adaptive_refuses_mode_weights(new_instance):
+    """Mode weights act on a fixed basis: an adaptive run (which approximates
+    the unweighted physics on a basis of its own) refuses any weight but 1,
+    says why, and steps on as before; weights of 1 are accepted."""
+    inst = new_instance()
+    inst.slave.setInt64([inst.vr["reduction"]], [3])
+    inst.initialize()
+    inst.step(0.01, 3)
+    n = int(inst.u64("nModes"))
+    with pytest.raises(FMICallException):
+        inst.set_f64("modeWeights", [0.5] + [1.0] * (n - 1))
+    assert any("modeWeights must be 1 in an adaptive run" in m for _, _, m in inst.messages), inst.messages
+    np.testing.assert_array_equal(inst.f64("modeWeights", n), np.ones(n))
+    inst.set_f64("modeWeights", np.ones(n))
+    inst.step(0.01)
+    assert np.all(np.isfinite(inst.positions()))

@@ -30,7 +30,7 @@ mod estimate;
 mod sheet;
 
 use super::{Reads, Run, SetUp, Steps};
-use crate::physics::error::PhysicsError;
+use crate::physics::error::{Expected, PhysicsError, Quantity};
 use crate::physics::run::error_model::ErrorState;
 use crate::physics::run::frame::dot;
 use crate::physics::run::integrator::Scheme;
@@ -159,6 +159,14 @@ fn inner_settings(settings: &Settings, reduction: Reduction, n_modes: usize) -> 
     Settings { reduction, n_modes, mode_selection: ModeSelection::Trained, ..settings.clone() }
 }
 
+/// Mode weights act on a fixed basis: an adaptive run refuses any but 1.
+pub(super) fn unweighted(loads: &Loads) -> Result<(), PhysicsError> {
+    match loads.mode_weights.iter().find(|w| **w != 1.0) {
+        Some(&value) => Err(PhysicsError::Invalid { quantity: Quantity::ModeWeights, value, expected: Expected::OneInAdaptive }),
+        None => Ok(()),
+    }
+}
+
 /// `dst` takes every load of `src` but the mode weights.
 fn copy_loads(dst: &mut Loads, src: &Loads) {
     dst.gravity = src.gravity;
@@ -175,6 +183,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// Set-up: the basis chosen for the tolerance ([`adaptive_basis::choose`]),
     /// the reduced run on it, the full-space run and the error model.
     pub fn new(scene: Scene, settings: &Settings, loads: &Loads, chosen: Chosen) -> Result<Self, PhysicsError> {
+        unweighted(loads)?;
         let full_settings = inner_settings(settings, Reduction::Full, 0);
         let full_loads = Loads { mode_weights: Vec::new(), ..loads.clone() };
         let full = Run::new(Full::new(scene.clone(), &full_loads, &full_settings)?, &full_settings, &full_loads)?;

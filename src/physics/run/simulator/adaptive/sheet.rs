@@ -1,7 +1,7 @@
 //! What the model and the tests use of an adaptive run: [`Steps`],
 //! [`Reads`] and [`SetUp`], each answered by the run that steps now.
 
-use super::{copy_loads, Adaptive, CAP_FACTOR, KEPT_POSES, LONGEST_STRETCH};
+use super::{copy_loads, unweighted, Adaptive, CAP_FACTOR, KEPT_POSES, LONGEST_STRETCH};
 use crate::physics::error::{positive, PhysicsError, Quantity};
 use crate::physics::run::error_model::ErrorState;
 use crate::physics::run::integrator::Scheme;
@@ -98,7 +98,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
     fn edit_loads(&mut self, edit: &mut dyn FnMut(&mut Loads)) -> Result<(), PhysicsError> {
         self.spare.clone_from(&self.loads);
         edit(&mut self.loads);
-        let checked = self.loads.validate(self.settings.n_modes).and_then(|()| self.loads.validate_on(self.reduced.scene()));
+        let checked =
+            self.loads.validate(self.settings.n_modes).and_then(|()| self.loads.validate_on(self.reduced.scene())).and_then(|()| unweighted(&self.loads));
         let host = &self.loads;
         let applied =
             checked.and_then(|()| self.reduced.edit_loads(&mut |l| copy_loads(l, host))).and_then(|()| self.full.edit_loads(&mut |l| copy_loads(l, host)));
