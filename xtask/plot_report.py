@@ -58,6 +58,21 @@ def e(r):
     return f(r, "error_window") if "error_window" in r else f(r, "error_resolved")
 
 
+def label(ax, xlabel, title, ylabel="trajectory error E over the window"):
+    """Axis labels, title, grid and legend of one panel."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+
+
+def save(fig, name):
+    fig.tight_layout()
+    fig.savefig(f"{out}/{name}.png", dpi=90)
+    plt.close(fig)
+
+
 def leaves_out(r):
     return r["method"] == "modal" and int(r["modes"]) < int(r["dofs"])
 
@@ -126,14 +141,8 @@ for ax, column, name in zip(axes, ["force_residual_max", "force_residual_mean"],
         ys += y
         ax.loglog([a for a in x if a > 0], [b for a, b in zip(x, y, strict=True) if a > 0], "o", color=cmap[i % len(cmap)], alpha=0.6, markersize=4,
                   label=f"{scene} (ρ = {spearman(x, y):.2f}, {len(x)} runs)")
-    ax.set_xlabel(f"{name} forceResidual over the run")
-    ax.set_ylabel("trajectory error E over the window")
-    ax.set_title(f"E against the {name} forceResidual, leave-out runs (Spearman {spearman(xs, ys):.2f})")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
-fig.tight_layout()
-fig.savefig(f"{out}/force_residual.png", dpi=90)
-plt.close(fig)
+    label(ax, f"{name} forceResidual over the run", f"E against the {name} forceResidual, leave-out runs (Spearman {spearman(xs, ys):.2f})")
+save(fig, "force_residual")
 
 # The adaptive runs' estimate against E.
 adaptive = [r for rs in by_scene.values() for r in rs if r["method"] == "adaptive"]
@@ -152,11 +161,5 @@ if adaptive:
             ax.loglog(line, line, "k-", lw=0.8, label="estimate = E")
             ax.loglog(line, line / 3, "k:", lw=0.8, label="E / 3 and 3 E")
             ax.loglog(line, line * 3, "k:", lw=0.8)
-        ax.set_xlabel(f"E {name}")
-        ax.set_ylabel("errorEstimate at the same time")
-        ax.set_title(f"adaptive runs: estimate against E {name}")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(f"{out}/adaptive_estimate.png", dpi=90)
-    plt.close(fig)
+        label(ax, f"E {name}", f"adaptive runs: estimate against E {name}", ylabel="errorEstimate at the same time")
+    save(fig, "adaptive_estimate")
