@@ -1,13 +1,15 @@
 //! Baked set-up: `resources/setup.bin`, written by `cargo xtask fmu --bake`,
 //! holds the costly products of the modal set-up ([`SetupData`]: basis,
-//! linearization point, cubature set) with the parameter values they were
-//! computed for. An instance whose values match uses them and skips the
-//! eigen decomposition, the equilibrium and the cubature training, with a
-//! bit-identical run; one whose values differ (or a file that is corrupt or
-//! from another build) computes the set-up and logs why.
+//! linearization point, cubature set; with reduction = adaptive also what
+//! its set-up chose, with the error model's directions and spring set) with
+//! the parameter values they were computed for. An instance whose values
+//! match uses them and skips the eigen decomposition, the equilibrium, the
+//! training runs and the cubature trainings, with a bit-identical run; one
+//! whose values differ (or a file that is corrupt or from another build)
+//! computes the set-up and logs why.
 //!
-//! The key is every structural and fixed parameter, the set-up gravity and
-//! the set-up point load,
+//! The key is every structural and fixed parameter (errorTolerance among
+//! them), the set-up gravity and the set-up point load,
 //! except those set-up does not read ([`NOT_READ_BY_SETUP`]). File layout
 //! (little-endian): magic `MMSBAKE1`, the crate version (u32 length +
 //! bytes), the key (u32 count, then per variable u32 value reference, u32
@@ -39,7 +41,8 @@ fn key(p: &Params) -> Vec<(u32, Vec<f64>)> {
         .collect()
 }
 
-/// The bake of `sim`, set up from `p`; `None` in full space (nothing costly to keep).
+/// The bake of `sim`, set up from `p` (an adaptive run's as set-up chose
+/// it, whatever it grew to since); `None` in full space (nothing costly to keep).
 pub fn write(p: &Params, sim: &Simulator) -> Option<Vec<u8>> {
     let data = sim.setup_data()?.to_bytes();
     let mut b = Vec::new();

@@ -28,4 +28,4 @@ pub use settings::{ForceEvaluation, Integrator, Linearization, ModeSelection, Re
 pub use setup::grid::{FixedNodes, Grid};
 pub use setup::mode_classes::ModeClasses;
 pub use setup::scene::{Holder, Scene, MAX_HOLDERS};
-pub use setup::setup_data::{SetupData, SpringSet, TrainedRange};
+pub use setup::setup_data::{AdaptiveChoice, SetupData, SpringSet, TrainedRange};

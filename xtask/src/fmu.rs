@@ -1,4 +1,4 @@
-//! `cargo xtask fmu [--scene NAME] [--nx N] [--ny N] [--modes R] [--bake] [--out PATH]`
+//! `cargo xtask fmu [--scene NAME] [--nx N] [--ny N] [--modes R] [--set NAME=VALUE]... [--bake] [--out PATH]`
 //!
 //! Builds the cdylib in release mode and packs the FMU: modelDescription.xml
 //! (generated from modelDescription/variables.toml with the chosen start
@@ -6,9 +6,10 @@
 //! node as terminals, from the same table: modelDescription/generate/terminals.rs),
 //! binaries/x86_64-linux/ModalMassSpring.so, documentation/index.html
 //! and resources/startValues.txt (the same start values, read by the binary).
-//! With `--bake`, also resources/setup.bin: the modal set-up of those start
-//! values (basis, equilibrium, cubature set), computed once here by the
-//! `bake` example so that instantiation skips it while the parameters match.
+//! With `--bake`, also resources/setup.bin: the modal or adaptive set-up of
+//! those start values (basis, equilibrium, cubature sets, and what the
+//! adaptive set-up chose), computed once here by the `bake` example so that
+//! instantiation skips it while the parameters match.
 
 use crate::cli::{self, Long, ValueExt};
 use crate::generate;
@@ -27,8 +28,8 @@ struct Options {
     nx: Option<u64>,
     ny: Option<u64>,
     modes: Option<u64>,
-    /// Other scalar start values, `--set NAME=VALUE`.
-    set: Vec<(String, f64)>,
+    /// Other scalar start values, `--set NAME=VALUE` (VALUE as given: a number or an enumeration item's name).
+    set: Vec<(String, String)>,
     bake: bool,
     out: Option<PathBuf>,
 }
@@ -40,9 +41,10 @@ usage: cargo xtask fmu [--scene NAME] [--nx N] [--ny N] [--modes R] [--set NAME=
   --nx N        nodes per row (the load column follows the middle of the row)
   --ny N        rows of nodes
   --modes R     modes kept (nModes)
-  --set NAME=VALUE  the start value of another scalar parameter (enumerations by
-                value), e.g. --set nHolders=2 --set fixedNodes=2; repeatable
-  --bake        also resources/setup.bin: the modal set-up of these start values
+  --set NAME=VALUE  the start value of another scalar parameter or input; an
+                enumeration by item name or value, e.g. --set nHolders=2
+                --set fixedNodes=2 --set reduction=adaptive; repeatable
+  --bake        also resources/setup.bin: the modal or adaptive set-up of these start values
   --out PATH    where the FMU goes (default target/fmu/NAME.fmu, NAME the scene or
                 ModalMassSpring, with -nxN, -nyN, -modesR appended when given)";
 
@@ -58,8 +60,7 @@ fn parse(args: &[String]) -> Result<Option<Options>, cli::Error> {
             Long("set") => {
                 let pair = p.value()?.string()?;
                 let (name, value) = pair.split_once('=').ok_or_else(|| cli::Error::from(format!("--set {pair}: expected NAME=VALUE")))?;
-                let value: f64 = value.trim().parse().map_err(|_| cli::Error::from(format!("--set {pair}: {value} is not a number")))?;
-                o.set.push((name.trim().to_string(), value));
+                o.set.push((name.trim().to_string(), value.trim().to_string()));
             }
             Long("out") => o.out = Some(PathBuf::from(p.value()?)),
             Long("bake") => o.bake = true,
@@ -108,7 +109,7 @@ pub fn main(args: &[String]) -> Result<(), String> {
         if !var.dimensions.is_empty() || !matches!(var.causality.as_str(), "parameter" | "structuralParameter" | "input") {
             return Err(format!("--set {name}: only scalar parameters and inputs take a start value here"));
         }
-        overrides.insert(name.clone(), vec![*value]);
+        overrides.insert(name.clone(), vec![set_value(&spec, var, value)?]);
     }
     let check = |name: &str| -> Result<(), String> {
         let var = spec.variable(name).unwrap();
@@ -175,6 +176,28 @@ pub fn main(args: &[String]) -> Result<(), String> {
     std::fs::rename(&tmp, &out).map_err(|e| format!("{}: {e}", out.display()))?;
     println!("{}", out.display());
     Ok(())
+}
+
+/// The number `--set NAME=VALUE` gives `var`: an enumeration's item by
+/// name or by value (one of its items), else the number VALUE.
+fn set_value(spec: &generate::Spec, var: &generate::Variable, value: &str) -> Result<f64, String> {
+    let items = var.declared_type.as_ref().and_then(|t| spec.enumerations.iter().find(|e| &e.name == t)).map(|e| &e.items);
+    if let Some(item) = items.and_then(|items| items.iter().find(|i| i.name == value)) {
+        return Ok(item.value as f64);
+    }
+    let x: f64 = value.parse().map_err(|_| match items {
+        Some(items) => format!(
+            "--set {}={value}: not an item of {} ({})",
+            var.name,
+            var.declared_type.as_deref().unwrap_or(""),
+            items.iter().map(|i| format!("{} = {}", i.name, i.value)).collect::<Vec<_>>().join(", ")
+        ),
+        None => format!("--set {}={value}: {value} is not a number", var.name),
+    })?;
+    if items.is_some_and(|items| !items.iter().any(|i| i.value as f64 == x)) {
+        return Err(format!("--set {}={value}: no item of {} has the value {value}", var.name, var.declared_type.as_deref().unwrap_or("")));
+    }
+    Ok(x)
 }
 
 /// Runs the `bake` example on the start values; the bytes of setup.bin, or

@@ -34,6 +34,12 @@
 //! vectors: one cubature is trained for the basis and the error directions
 //! together ([`error_cubature`]); it serves the error model
 //! ([`crate::physics::run::error_directions`]) and every grown basis.
+//!
+//! **Stored.** What costs time here (the training runs, the basis and both
+//! cubatures) is kept as set-up data with an adaptive section
+//! ([`Chosen::stored`]); [`choose_from`] rebuilds the same choice from it,
+//! bit for bit, deriving the rest again (the stiffness at x*, the trained
+//! vectors, the settings of the trained basis).
 
 use crate::physics::error::PhysicsError;
 use crate::physics::run::error_directions::error_directions;
@@ -45,7 +51,7 @@ use crate::physics::setup::basis;
 use crate::physics::setup::cubature_training;
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
-use crate::physics::setup::setup_data::{SetupData, SpringSet};
+use crate::physics::setup::setup_data::{AdaptiveChoice, SetupData, SpringSet};
 use crate::physics::setup::trained_basis::{self, principal_components, Linearized};
 
 /// Share of the tolerance the held-out projection error may take.
@@ -55,34 +61,32 @@ pub const CAP_FACTOR: usize = 2;
 /// Share of the set-up size one return from full space may add (at least one vector).
 pub const GROWTH: f64 = 0.25;
 
-/// What set-up chose for an adaptive run.
+/// What set-up chose for an adaptive run: the stored part ([`Chosen::stored`]) and what is derived from it.
 pub struct Chosen {
-    /// The trained basis (and its cubature, if asked for).
+    /// The trained basis (and its cubature, if asked for); no adaptive section (that is `choice`).
     pub data: SetupData,
-    /// Principal components kept, and the held-out projection error they reach.
-    pub components: usize,
-    pub held_out_error: f64,
-    /// The fewest components would reach the tolerance's share only with
-    /// more than the snapshots hold: the basis holds every component.
-    pub short: bool,
-    /// sqrt of the mean of ‖d_k‖²_M over the snapshots: how far the scene
-    /// moves under its program [m sqrt(kg)].
-    pub motion_scale: f64,
+    /// The rest of what set-up chose: the components kept and their
+    /// held-out error, the motion scale, the training poses, the error
+    /// model's candidate directions (the held-out split's principal
+    /// components beyond the basis, up to [`ERROR_DIRECTIONS`] times as many
+    /// as it holds, and the rigid translations) and, with cubature forces,
+    /// its spring set.
+    pub choice: AdaptiveChoice,
     /// The stiffness at the linearization point, for the error model.
     pub pattern: StiffnessPattern,
     pub stiffness: Vec<f64>,
     /// The basis vectors of the trained set-up, as columns (kept through every growth).
     pub trained: Vec<Vec<f64>>,
-    /// The training snapshots' coordinates in the trained basis (the cubature's poses on a return).
-    pub poses: Vec<Vec<f64>>,
     /// The settings of the trained basis: its size, force model and cubature tolerance.
     pub settings: Settings,
-    /// Candidates for the error model's directions: the held-out split's
-    /// principal components beyond the basis (up to [`ERROR_DIRECTIONS`]
-    /// times as many as it holds) and the rigid translations.
-    pub error_directions: Vec<Vec<f64>>,
-    /// With cubature forces, the error model's spring set (also the grown bases' cubature).
-    pub error_set: Option<SpringSet>,
+}
+
+impl Chosen {
+    /// The set-up data [`choose_from`] rebuilds this choice from: the
+    /// trained basis with the choice as its adaptive section.
+    pub fn stored(&self) -> SetupData {
+        SetupData { adaptive: Some(self.choice.clone()), ..self.data.clone() }
+    }
 }
 
 /// The error model may take this many times as many principal components as the basis holds.
@@ -158,12 +162,7 @@ pub fn choose(scene: &Scene, loads: &Loads, settings: &Settings) -> Result<Chose
     let per_vector = scene.springs.len() / size.max(1);
     let cubature = (per_vector >= CUBATURE_PAYS || settings.force_evaluation == ForceEvaluation::Cubature && per_vector >= CUBATURE_SPRINGS_PER_VECTOR)
         && size + error_directions.len() <= JOINT_CUBATURE_MODES;
-    let sized = Settings {
-        n_modes: size,
-        force_evaluation: if cubature { ForceEvaluation::Cubature } else { ForceEvaluation::Exact },
-        cubature_tolerance: settings.error_tolerance.min(1.0),
-        ..trained_settings
-    };
+    let sized = sized_settings(settings, size, cubature);
     let data = trained_basis::train_on(scene.clone(), loads, &sized, at, statics, &columns)?;
     let poses: Vec<Vec<f64>> = columns
         .iter()
@@ -176,20 +175,62 @@ pub fn choose(scene: &Scene, loads: &Loads, settings: &Settings) -> Result<Chose
     drop(columns);
     let error_set = if cubature { Some(error_cubature(scene, loads, &sized, &data, &error_directions, &poses)?) } else { None };
     let trained = columns_of(&data.basis);
-    Ok(Chosen {
+    let choice = AdaptiveChoice {
         held_out_error: errors[components.min(errors.len() - 1)],
         components,
         short: found.is_none(),
         motion_scale,
-        data,
-        pattern,
-        stiffness,
-        trained,
         poses,
         error_directions,
         error_set,
-        settings: sized,
-    })
+    };
+    Ok(Chosen { data, choice, pattern, stiffness, trained, settings: sized })
+}
+
+/// The settings of the trained basis of `size` vectors an adaptive run
+/// with `settings` steps on, with cubature forces or exact ones; the
+/// cubature is trained to the error tolerance (at most 1).
+fn sized_settings(settings: &Settings, size: usize, cubature: bool) -> Settings {
+    Settings {
+        n_modes: size,
+        mode_selection: ModeSelection::Trained,
+        force_evaluation: if cubature { ForceEvaluation::Cubature } else { ForceEvaluation::Exact },
+        cubature_tolerance: settings.error_tolerance.min(1.0),
+        ..settings.clone()
+    }
+}
+
+/// [`choose`] from what it stored ([`Chosen::stored`] of a set-up of the
+/// same scene, set-up loads and settings), bit for bit: the stiffness at
+/// the stored linearization point assembled as [`basis::linearize`]
+/// assembles it, the trained vectors the stored basis's columns, the
+/// settings those of a basis of its size with cubature forces where it has
+/// a cubature. Refuses data without an adaptive section or whose sizes or
+/// spring sets do not fit `scene` (the basis itself is checked where the
+/// reduced run takes it).
+pub fn choose_from(scene: &Scene, settings: &Settings, stored: &SetupData) -> Result<Chosen, PhysicsError> {
+    let fail = |what| Err(PhysicsError::SetupDataMismatch { what });
+    let Some(choice) = &stored.adaptive else {
+        return fail("it holds no adaptive set-up");
+    };
+    let (n, r) = (stored.basis.n, stored.basis.r);
+    if n != scene.n_dofs() || Some(stored.basis.phi.len()) != n.checked_mul(r) || stored.point.len() != scene.rest.len() {
+        return fail("basis size");
+    }
+    if !choice.fits(n, r) {
+        return fail("adaptive set-up");
+    }
+    let springs = scene.springs.len();
+    if choice.error_set.is_some() != stored.cubature.is_some() || choice.error_set.as_ref().is_some_and(|c| c.springs.iter().any(|&s| s >= springs)) {
+        return fail("error model's spring set");
+    }
+    let mut data = stored.clone();
+    let choice = data.adaptive.take().expect("checked above");
+    let pattern = StiffnessPattern::new(scene);
+    let stiffness = basis::stiffness_at(scene, &pattern, &data.point);
+    let trained = columns_of(&data.basis);
+    let settings = sized_settings(settings, r, data.cubature.is_some());
+    Ok(Chosen { data, choice, pattern, stiffness, trained, settings })
 }
 
 /// The cubature of the error model (`crate::physics::run::error_directions`): a spring
@@ -214,7 +255,7 @@ fn error_cubature(
     }
     let top = b.lambda.iter().copied().fold(0.0, f64::max);
     let lambda = b.lambda.iter().copied().chain(std::iter::repeat_n(top, k)).collect();
-    let joint = SetupData { basis: ModalBasis { n, r: r + k, lambda, phi }, cubature: None, range: None, ..data.clone() };
+    let joint = SetupData { basis: ModalBasis { n, r: r + k, lambda, phi }, cubature: None, range: None, adaptive: None, ..data.clone() };
     let padded: Vec<Vec<f64>> = poses.iter().map(|q| q.iter().copied().chain(std::iter::repeat_n(0.0, k)).collect()).collect();
     let settings = Settings { n_modes: r + k, force_evaluation: ForceEvaluation::Cubature, ..settings.clone() };
     let trained = cubature_training::train(scene.clone(), loads, &settings, Some(&joint), Some(&padded))?;
@@ -268,7 +309,8 @@ pub fn grown_setup(scene: &Scene, chosen: &Chosen, vectors: &[Vec<f64>]) -> Resu
         point: chosen.data.point.clone(),
         at_rest: chosen.settings.linearization == Linearization::Rest,
         omega_sq_bound,
-        cubature: chosen.error_set.clone(),
+        cubature: chosen.choice.error_set.clone(),
         range: None,
+        adaptive: None,
     })
 }

@@ -122,9 +122,16 @@ pub fn linearize(scene: &Scene, loads: &Loads, settings: &Settings) -> Result<(V
         Linearization::Rest => scene.rest.clone(),
         Linearization::Equilibrium => equilibrium(scene, &pattern, &external_load(scene, loads))?,
     };
-    let mut stiffness = vec![0.0; pattern.nnz()];
-    pattern.add_tangent(scene, &point, 1.0, &mut stiffness);
+    let stiffness = stiffness_at(scene, &pattern, &point);
     Ok((point, pattern, stiffness))
+}
+
+/// The upper triangle of K(x) on `pattern` (x over every slot): what
+/// [`linearize`] assembles at its point, bit for bit.
+pub fn stiffness_at(scene: &Scene, pattern: &StiffnessPattern, x: &[f64]) -> Vec<f64> {
+    let mut stiffness = vec![0.0; pattern.nnz()];
+    pattern.add_tangent(scene, x, 1.0, &mut stiffness);
+    stiffness
 }
 
 /// The vectors a static correction adds to a basis linearized at `point`:

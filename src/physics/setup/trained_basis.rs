@@ -323,7 +323,7 @@ pub fn train_on(
         .collect();
     let range = TrainedRange::of(&poses, r);
     let at_rest = settings.linearization == Linearization::Rest;
-    let data = SetupData { basis: modes, point, at_rest, omega_sq_bound, cubature: None, range: Some(range) };
+    let data = SetupData { basis: modes, point, at_rest, omega_sq_bound, cubature: None, range: Some(range), adaptive: None };
     if settings.force_evaluation == ForceEvaluation::Cubature {
         return cubature_training::train(scene, loads, settings, Some(&data), Some(&poses));
     }

@@ -21,7 +21,7 @@ pub enum Estimator {
 impl Estimator {
     /// The model for `chosen` beside `basis`, and its zero state.
     pub fn new(scene: &Scene, chosen: &Chosen, basis: &ModalBasis) -> Result<(Self, ErrorState), PhysicsError> {
-        Ok(match &chosen.error_set {
+        Ok(match &chosen.choice.error_set {
             None => (
                 Estimator::Full(ErrorModel::new(&scene.dof_mass, chosen.pattern.clone(), chosen.stiffness.clone(), scene.rest.len())?),
                 ErrorState::zero(scene.n_dofs()),
@@ -35,7 +35,7 @@ impl Estimator {
     }
 
     pub fn directions(scene: &Scene, chosen: &Chosen, basis: &ModalBasis, set: &SpringSet) -> DirectionModel {
-        let directions = error_directions(&scene.dof_mass, basis, &chosen.error_directions);
+        let directions = error_directions(&scene.dof_mass, basis, &chosen.choice.error_directions);
         DirectionModel::new(scene, &directions, set, &chosen.data.point)
     }
 

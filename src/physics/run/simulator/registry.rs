@@ -64,7 +64,8 @@ impl DerefMut for Simulator {
 /// space) and binds it to the scheme `settings.integrator` names, or
 /// refuses a pair the scheme cannot integrate. `loads` are those at
 /// set-up: the basis options that depend on the loads use them.
-/// `prebuilt` (modal space only) replaces the costly part of the set-up.
+/// `prebuilt` (modal space; adaptive, with its adaptive section) replaces
+/// the costly part of the set-up.
 fn build(scene: Scene, settings: &Settings, loads: &Loads, prebuilt: Option<&SetupData>) -> Result<Box<dyn Sheet>, PhysicsError> {
     // A trained basis (and its cubature) comes from its training program unless it is stored.
     let trained_basis;
@@ -94,7 +95,11 @@ fn build(scene: Scene, settings: &Settings, loads: &Loads, prebuilt: Option<&Set
         Reduction::Full => bind(Full::new(scene, loads, settings)?, settings, loads),
         Reduction::Adaptive => {
             positive(Quantity::ErrorTolerance, settings.error_tolerance)?;
-            let chosen = adaptive_basis::choose(&scene, loads, settings)?;
+            // The choice is rebuilt from its stored form unless it must be computed.
+            let chosen = match prebuilt {
+                Some(data) => adaptive_basis::choose_from(&scene, settings, data)?,
+                None => adaptive_basis::choose(&scene, loads, settings)?,
+            };
             let c = chosen.settings.force_evaluation == ForceEvaluation::Cubature;
             Ok(match (settings.integrator, c) {
                 (Integrator::NewmarkExplicit, false) => Box::new(Adaptive::<Exact, NewmarkExplicit, NewmarkExplicit>::new(scene, settings, loads, chosen)?),

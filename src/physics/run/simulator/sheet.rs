@@ -127,8 +127,8 @@ pub trait SetUp {
     /// Every mode of [`Self::mode_shapes`] laid out on the grid as the node
     /// outputs are, `[r][n_nodes][dim]`, 0 on held nodes (empty without). O(n r).
     fn mode_grid_shapes(&self) -> Vec<f64>;
-    /// The costly products of the set-up (modal space only), to store and
-    /// pass to [`Self::with_setup`] later.
+    /// The costly products of the set-up (modal space, and an adaptive run's
+    /// set-up as it chose it), to store and pass to [`Self::with_setup`] later.
     fn setup_data(&self) -> Option<SetupData>;
     /// Springs one force evaluation visits: every spring, or the cubature set.
     fn cubature_springs(&self) -> usize;

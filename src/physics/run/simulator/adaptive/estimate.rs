@@ -159,7 +159,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
                 let (mut e, mut v) = old.error_of(&self.error);
                 e.iter_mut().zip(left).for_each(|(e, l)| *e += l);
                 v.iter_mut().zip(left_rate).for_each(|(e, l)| *e += l);
-                let set = self.chosen.error_set.as_ref().expect("a direction model has a spring set");
+                let set = self.chosen.choice.error_set.as_ref().expect("a direction model has a spring set");
                 let model = Estimator::directions(self.full.space.scene(), &self.chosen, basis, set);
                 self.error = ErrorState::zero(model.directions());
                 model.add(&mut self.error, &e, &v);

@@ -180,7 +180,8 @@ fn copy_loads(dst: &mut Loads, src: &Loads) {
 }
 
 impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
-    /// Set-up: the basis chosen for the tolerance ([`adaptive_basis::choose`]),
+    /// Set-up: the basis chosen for the tolerance ([`adaptive_basis::choose`],
+    /// or rebuilt from stored set-up data by [`adaptive_basis::choose_from`]),
     /// the reduced run on it, the full-space run and the error model.
     pub fn new(scene: Scene, settings: &Settings, loads: &Loads, chosen: Chosen) -> Result<Self, PhysicsError> {
         unweighted(loads)?;
@@ -377,7 +378,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
 
     /// The estimated error of the state has passed its share of the tolerance.
     fn must_fall_back(&self) -> bool {
-        let motion = self.last_motion_sq.max(self.chosen.motion_scale.powi(2));
+        let motion = self.last_motion_sq.max(self.chosen.choice.motion_scale.powi(2));
         let error = self.last_error_sq;
         !(error <= (FALL_BACK * self.settings.error_tolerance).powi(2) * motion)
     }
@@ -465,7 +466,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         let mut reduced = self.grown_run(&grown, &self.loads)?;
         let basis = reduced.space.basis().clone();
         // The grown basis must hold the state and the stretch's poses.
-        let motion = self.motion_sq().max(self.chosen.motion_scale.powi(2));
+        let motion = self.motion_sq().max(self.chosen.choice.motion_scale.powi(2));
         let limit = (PROJECTION_SHARE * self.settings.error_tolerance).powi(2) * motion;
         let left = |s: &[f64]| -> f64 {
             let mut q = vec![0.0; basis.r];

@@ -311,8 +311,9 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> SetUp for Adaptive<F, R, X> {
         crate::physics::setup::mode_classes::grid_shapes(self.reduced.scene(), &self.reported)
     }
 
+    /// What set-up chose (not the basis grown since): the trained basis with its adaptive section.
     fn setup_data(&self) -> Option<SetupData> {
-        None
+        Some(self.chosen.stored())
     }
 
     fn cubature_springs(&self) -> usize {

@@ -140,6 +140,7 @@ impl<F: ReducedForce> Constants for Modal<F> {
             omega_sq_bound: self.bound,
             cubature: self.force.spring_set(),
             range: self.range.clone(),
+            adaptive: None,
         })
     }
 
