@@ -58,6 +58,8 @@ fn run_shaken(n: usize, g: [f64; 3], p: [f64; 3], amplitude: f64, tolerance: f64
         }
         full.do_step(H).unwrap();
         sim.do_step(H).unwrap();
+        // Every step took internal steps, in whichever run (a return starts a new one).
+        assert!(sim.internal_steps_last() >= 1, "step {k}: {} internal steps", sim.internal_steps_last());
         let (x, y) = (full.positions(), sim.positions().to_vec());
         error += x.iter().zip(&y).map(|(a, b)| (a - b).powi(2)).sum::<f64>();
         motion += x.iter().zip(&start).map(|(a, b)| (a - b).powi(2)).sum::<f64>();

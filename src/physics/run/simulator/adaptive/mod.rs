@@ -104,6 +104,8 @@ pub struct Adaptive<F: ReducedForce, R: Scheme, X: Scheme> {
     reduced: Run<Modal<F>, R>,
     full: Run<Full, X>,
     in_full: bool,
+    /// Internal steps the last communication step took.
+    last_steps: usize,
     /// The basis is small enough to pay ([`DOFS_PER_VECTOR`]): else full space throughout.
     reduces: bool,
     chosen: Chosen,
@@ -196,6 +198,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             reduced,
             full,
             in_full: false,
+            last_steps: 0,
             reduces: n >= DOFS_PER_VECTOR * chosen.data.basis.r,
             grown: Vec::new(),
             model,

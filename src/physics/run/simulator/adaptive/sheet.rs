@@ -22,52 +22,10 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
 
     fn do_step(&mut self, h: f64) -> Result<(), PhysicsError> {
         positive(Quantity::StepSize, h)?;
-        if self.in_full {
-            self.step_full(h)?;
-            self.report_coordinates();
-            return Ok(());
-        }
-        if self.outside_program() {
-            // A basis trained for other loads: full space from the start of the step.
-            self.lift();
-            return self.step_full(h).inspect(|_| self.report_coordinates());
-        }
-        let due = self.wait + 1 >= self.gap;
-        if due {
-            self.spare_error.copy_from(&self.error);
-            self.spare_tally = self.tally;
-        }
-        self.kick_error(h);
-        let (wait, since) = (self.wait, self.since);
-        self.reduced.do_step(h)?;
-        let steps = self.reduced.internal_steps_last as u64;
-        self.tally.reduced_steps += steps;
-        self.tally.steps += steps;
-        self.wait += 1;
-        self.since += h;
-        if !due {
-            self.report_coordinates();
-            return Ok(());
-        }
-        self.update_period();
-        let estimated = self.estimate();
-        if estimated.is_ok() && !self.must_fall_back() {
-            self.report_coordinates();
-            return Ok(());
-        }
-        // Undone, and taken again in full space from the lifted state.
-        self.error.copy_from(&self.spare_error);
-        self.tally = self.spare_tally;
-        self.wait = wait;
-        self.since = since;
-        self.undo_reduced();
-        estimated?;
-        self.lift();
-        if let Err(e) = self.step_full(h) {
-            self.in_full = false;
-            return Err(e);
-        }
-        self.report_coordinates();
+        let before = self.tally.steps;
+        self.step_either(h)?;
+        // The internal steps this call took, in whichever runs took them (a return starts a new reduced run).
+        self.last_steps = (self.tally.steps - before) as usize;
         Ok(())
     }
 
@@ -92,7 +50,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
     }
 
     fn internal_steps_last(&self) -> usize {
-        self.active().internal_steps_last()
+        self.last_steps
     }
 
     fn edit_loads(&mut self, edit: &mut dyn FnMut(&mut Loads)) -> Result<(), PhysicsError> {
@@ -332,5 +290,58 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> SetUp for Adaptive<F, R, X> {
                 Estimator::Full(_) => 0,
             },
         }
+    }
+}
+
+impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
+    /// One communication step, reduced or in full space (see the module documentation).
+    fn step_either(&mut self, h: f64) -> Result<(), PhysicsError> {
+        if self.in_full {
+            self.step_full(h)?;
+            self.report_coordinates();
+            return Ok(());
+        }
+        if self.outside_program() {
+            // A basis trained for other loads: full space from the start of the step.
+            self.lift();
+            return self.step_full(h).inspect(|_| self.report_coordinates());
+        }
+        let due = self.wait + 1 >= self.gap;
+        if due {
+            self.spare_error.copy_from(&self.error);
+            self.spare_tally = self.tally;
+        }
+        self.kick_error(h);
+        let (wait, since) = (self.wait, self.since);
+        self.reduced.do_step(h)?;
+        let steps = self.reduced.internal_steps_last as u64;
+        self.tally.reduced_steps += steps;
+        self.tally.steps += steps;
+        self.wait += 1;
+        self.since += h;
+        if !due {
+            self.report_coordinates();
+            return Ok(());
+        }
+        self.update_period();
+        let estimated = self.estimate();
+        if estimated.is_ok() && !self.must_fall_back() {
+            self.report_coordinates();
+            return Ok(());
+        }
+        // Undone, and taken again in full space from the lifted state.
+        self.error.copy_from(&self.spare_error);
+        self.tally = self.spare_tally;
+        self.wait = wait;
+        self.since = since;
+        self.undo_reduced();
+        estimated?;
+        self.lift();
+        if let Err(e) = self.step_full(h) {
+            self.in_full = false;
+            return Err(e);
+        }
+        self.report_coordinates();
+        Ok(())
     }
 }
