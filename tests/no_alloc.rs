@@ -107,7 +107,7 @@ fn adaptive_steps_allocate_nothing() {
             canonical_scenes::cloth(30, 30)
         } else {
             // Large enough for its basis to pay (at most one vector per ADAPTIVE_DOFS_PER_VECTOR DOFs).
-            canonical_scenes::cloth(24, 24)
+            canonical_scenes::cloth(30, 30)
         };
         let mut setup = scene.with_settings(Settings {
             error_tolerance: if force_evaluation == ForceEvaluation::Cubature { 0.05 } else { settings.error_tolerance },

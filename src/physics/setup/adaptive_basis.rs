@@ -54,6 +54,15 @@ use crate::physics::setup::scene::Scene;
 use crate::physics::setup::setup_data::{AdaptiveChoice, SetupData, SpringSet};
 use crate::physics::setup::trained_basis::{self, principal_components, Linearized};
 
+/// The reduced model pays where the chosen basis holds at most one vector
+/// per this many free DOFs; on a smaller scene the run is full space
+/// throughout. A reduced step expands and projects through the basis (2 n r
+/// flops each way, at least n²/8 beyond this) besides its force pass; a
+/// full-space step costs a pass over the springs, a few per DOF (measured
+/// in report/: on paper-2d-top-row, 180 DOFs and 34 vectors, a run with the
+/// estimate took 7x the full-space run's time at the same step).
+pub const DOFS_PER_VECTOR: usize = 32;
+
 /// Share of the tolerance the held-out projection error may take.
 pub const PROJECTION_SHARE: f64 = 0.25;
 /// The basis may grow to this many times its size at set-up.

@@ -34,7 +34,6 @@ mod stepping;
 
 use std::marker::PhantomData;
 
-pub use adaptive::DOFS_PER_VECTOR as ADAPTIVE_DOFS_PER_VECTOR;
 pub use sheet::{Reads, ReductionStatus, SetUp, Sheet, Steps};
 
 use crate::physics::run::frame::into_frame;

@@ -38,7 +38,7 @@ use crate::physics::run::simulator::estimators::Estimator;
 use crate::physics::run::space::{Constants, Full, Modal, Readout, ReducedForce};
 use crate::physics::run::state::{Loads, State};
 use crate::physics::settings::{ModeSelection, Reduction, Settings};
-use crate::physics::setup::adaptive_basis::{self, Chosen, CAP_FACTOR, GROWTH, PROJECTION_SHARE};
+use crate::physics::setup::adaptive_basis::{self, Chosen, CAP_FACTOR, DOFS_PER_VECTOR, GROWTH, PROJECTION_SHARE};
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
 use crate::physics::setup::setup_data::SetupData;
@@ -59,14 +59,6 @@ pub const ESTIMATE_SHARE: f64 = 0.25;
 pub const LONGEST_GAP: u64 = 32;
 /// The most poses of a stretch in full space kept for the basis to grow by.
 pub const KEPT_POSES: usize = 32;
-/// The reduced model pays where the chosen basis holds at most one vector
-/// per this many free DOFs; on a smaller scene the run is full space
-/// throughout. A reduced step expands and projects through the basis (2 n r
-/// flops each way, at least n²/8 beyond this) besides its force pass; a
-/// full-space step costs a pass over the springs, a few per DOF (measured
-/// in report/: on paper-2d-top-row, 180 DOFs and 34 vectors, a run with the
-/// estimate took 7x the full-space run's time at the same step).
-pub const DOFS_PER_VECTOR: usize = 32;
 
 /// What the estimate of E counts: sums over the communication points.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
