@@ -415,6 +415,11 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             self.estimate()?;
         }
         self.stretch += 1;
+        if !self.reduces {
+            // A run that never returns keeps no poses and no stretch.
+            self.stretch = 0;
+            return Ok(());
+        }
         // The pose into the oldest of the kept ones.
         let slot = &mut self.seen[self.seen_next];
         let rest = &self.full.space.scene().rest;
