@@ -32,7 +32,7 @@ use cli::{Value, ValueExt};
 
 /// Every task: its name, its entry point and what it does (`cargo xtask --help`).
 type Task = fn(&[String]) -> Result<(), String>;
-const TASKS: [(&str, Task, &str); 14] = [
+const TASKS: [(&str, Task, &str); 15] = [
     ("fmu", fmu::main, "build the release library and package target/fmu/ModalMassSpring.fmu"),
     ("run", run::run, "build the FMU and run the main job through fmpy (summary + plot)"),
     ("test", run::test, "every test: Rust (cargo test) and Python (pytest + fmpy); --only STAGE,... for some"),
@@ -46,6 +46,7 @@ const TASKS: [(&str, Task, &str); 14] = [
     ("control", run::control, "the paper's control experiments (Figs. 7-9, a GIF) and control in 3D, through the FMU, into target/control"),
     ("modes", modes::main, "the mode gallery of a scene: shapes, frequencies and classes into target/modes (PNG, Markdown)"),
     ("docs", docs::main, "the variable tables of docs/variables.md, from modelDescription/variables.toml"),
+    ("view", run::view, "the sheet live in a browser: one FMU instance per page, steered from the page (python/view.py)"),
     ("ssp", ssp::main, "the two-sheet chain of python/chain.py as an SSP 1.0 archive, target/ssp/chain.ssp"),
 ];
 

@@ -76,26 +76,45 @@ pub fn control(args: &[String]) -> Result<(), String> {
     fmu_job(args, CONTROL_USAGE, "python/control.py", "control figures")
 }
 
+const VIEW_USAGE: &str = "\
+usage: cargo xtask view [--] [--scene NAME] [--set NAME=VALUE ...] [--port P] [--fps F] [--no-open]
+
+Installs what it needs (viser), builds target/fmu/ModalMassSpring.fmu and
+runs python/view.py on it: a server on 127.0.0.1 that runs one FMU instance
+per browser page in real time, draws the sheet and lets the page steer it
+(mode weights and classes, gravity, damping, the holders, the load node).
+docs/view.md explains the page.";
+
+pub fn view(args: &[String]) -> Result<(), String> {
+    let Some(args) = cli::options(cli::pass_through(args), VIEW_USAGE)? else {
+        setup::python_help("python/view.py");
+        return Ok(());
+    };
+    step("setup: what the view needs");
+    setup::install(setup::Purpose::View)?;
+    python_on_fmu(&args, "python/view.py", "view")
+}
+
 /// Setup, the default FMU, then `script FMU ARGS...` in the venv's Python.
 fn fmu_job(args: &[String], usage: &str, script: &str, what: &str) -> Result<(), String> {
     let Some(args) = cli::options(cli::pass_through(args), usage)? else {
         setup::python_help(script);
         return Ok(());
     };
-    let root = setup::root();
     step("setup: what building and running need");
     setup::install(setup::Purpose::Run)?;
+    python_on_fmu(&args, script, what)
+}
+
+/// The default FMU built, then `script FMU ARGS...` in the venv's Python.
+fn python_on_fmu(args: &[String], script: &str, what: &str) -> Result<(), String> {
+    let root = setup::root();
     step("cargo xtask fmu");
     fmu::main(&[])?;
     let fmu = fmu_dir(&root).join("ModalMassSpring.fmu");
     step(&format!("{what}: {script}"));
-    let status = Command::new(setup::python())
-        .current_dir(&root)
-        .arg(script)
-        .arg(&fmu)
-        .args(&args)
-        .status()
-        .map_err(|e| format!("cannot run the venv's python: {e}"))?;
+    let status =
+        Command::new(setup::python()).current_dir(&root).arg(script).arg(&fmu).args(args).status().map_err(|e| format!("cannot run the venv's python: {e}"))?;
     if !status.success() {
         return Err(format!("the {what} failed ({status})"));
     }

@@ -8,10 +8,12 @@
 //!   (the libFuzzer runtime `cargo xtask fuzz` links) and what the reference
 //!   importer fmusim is built with (`cargo xtask fmusim`): `gcc`,
 //!   `libsundials-dev`, `libminizip-dev`, `zlib1g-dev` and `libxml2-dev`;
-//!   `libtbb12`, which Ecos's library (ecospy) links.
+//!   `libtbb12`, which Ecos's library (ecospy) links; Chromium and its
+//!   driver, the browser the view's tests drive headless (with selenium).
 //! - The Python environment `.venv` in the repository root: fmpy, numpy and
 //!   matplotlib to run the main job; dask.distributed for parameter sweeps
-//!   (`cargo xtask sweep`, python/sweep.py); for the tests pytest and
+//!   (`cargo xtask sweep`, python/sweep.py); viser for the live view
+//!   (`cargo xtask view`, python/view.py); for the tests pytest and
 //!   fmu-manipulation-toolbox (its `fmucontainer` is one of the co-simulation
 //!   masters `tests/python/test_chain.py` runs the FMU under) and ecospy
 //!   (the Ecos co-simulation engine, `tests/python/test_ecos.py`); ruff,
@@ -29,6 +31,8 @@ pub enum Purpose {
     Run,
     /// Also parameter sweeps on Dask (`cargo xtask sweep`).
     Sweep,
+    /// Also the live view in a browser (`cargo xtask view`).
+    View,
     /// Everything `cargo xtask test` runs: also fuzzing, valgrind, the XSD check and pytest.
     Test,
 }
@@ -46,6 +50,9 @@ const DEBIAN_PACKAGES: &[(&str, Purpose)] = &[
     ("zlib1g-dev", Purpose::Test),
     // ecospy's libecosc.so (Ecos, tests/python/test_ecos.py)
     ("libtbb12", Purpose::Test),
+    // the browser the view's tests drive headless (tests/python/test_view.py)
+    ("chromium", Purpose::Test),
+    ("chromium-driver", Purpose::Test),
 ];
 
 /// Python packages: (distribution name as pip knows it, requirement to
@@ -58,6 +65,9 @@ const PYTHON_PACKAGES: &[(&str, &str, Purpose)] = &[
     ("numpy", "numpy", Purpose::Run),
     ("matplotlib", "matplotlib", Purpose::Run),
     ("distributed", "dask[distributed]==2026.8.0", Purpose::Sweep),
+    // the live view's server and its bundled three.js client
+    ("viser", "viser==1.1.1", Purpose::View),
+    ("selenium", "selenium==4.51.0", Purpose::Test),
     ("pytest", "pytest", Purpose::Test),
     ("fmu_manipulation_toolbox", "fmu_manipulation_toolbox==2.0", Purpose::Test),
     ("ecospy", "ecospy==0.7.2", Purpose::Test),
@@ -104,10 +114,11 @@ pub fn main(args: &[String]) -> Result<(), String> {
 }
 
 const USAGE: &str = "\
-usage: cargo xtask setup [--for run|sweep|test]
+usage: cargo xtask setup [--for run|sweep|view|test]
 
   --for run    what building the FMU and the main job need
   --for sweep  also parameter sweeps on Dask
+  --for view   also the live view in a browser
   --for test   also everything the tests need (the default)";
 
 fn parse(args: &[String]) -> Result<Option<Purpose>, cli::Error> {
@@ -119,8 +130,9 @@ fn parse(args: &[String]) -> Result<Option<Purpose>, cli::Error> {
                 purpose = match p.value()?.string()?.as_str() {
                     "run" => Purpose::Run,
                     "sweep" => Purpose::Sweep,
+                    "view" => Purpose::View,
                     "test" => Purpose::Test,
-                    other => return Err(format!("--for {other}: one of run, sweep, test").into()),
+                    other => return Err(format!("--for {other}: one of run, sweep, view, test").into()),
                 }
             }
             arg if cli::is_help(&arg) => return Ok(None),

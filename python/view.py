@@ -1,0 +1,153 @@
+"""The sheet live in a browser: a local server (viser, bound to 127.0.0.1
+only) that loads the FMU with fmpy, runs one instance per page in real time
+and draws it in 3D (2D scenes flat), with its controls beside it.
+
+    .venv/bin/python python/view.py [FMU] [--scene NAME] [--set NAME=VALUE ...] [--port 8080] [--no-open]
+    cargo xtask view -- --scene cloth-3d
+
+Scenes: `default` (the FMU's start values), the canonical scenes of
+modelDescription/variables.toml and `cloth-3d-100x100` (cloth 100 x 100 on
+16 load modes with static correction). --set NAME=VALUE sets any parameter
+or structural parameter on top, in every scene the picker offers
+(Enumerations by item name, Booleans true/false, arrays as values separated
+by spaces). Every scene is set up with anchorMotion and anchorRotation, so a
+modal basis of load modes holds the holders' motion.
+
+Each page gets its own FMU instance (freed when the page closes); a value a
+page sends is checked before the FMU sees it and a refused one is shown on
+the page with the reason, the instance keeping its last good state.
+"""
+
+import argparse
+import os
+import sys
+import threading
+import time
+import webbrowser
+
+from sheet import Fmu, scene
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DEFAULT_FMU = os.path.join(ROOT, "target", "fmu", "ModalMassSpring.fmu")
+BIG = {"nx": 100, "ny": 100, "dimension": 3, "fixedNodes": 1, "auxStiffness": 0.05, "loadColumn": 50}
+BIG.update({"nModes": 16, "modeSelection": "load", "staticCorrection": True})
+PREPARED = {"anchorMotion": True, "anchorRotation": True}
+
+
+def parse_value(var, text):
+    """A --set value as the variable's type wants it."""
+    if var.type == "Boolean":
+        if text.lower() not in ("true", "false", "1", "0"):
+            raise ValueError(f"{var.name}: true or false, not {text!r}")
+        return text.lower() in ("true", "1")
+    if var.type == "Enumeration":
+        return int(text) if text.isdigit() else text
+    if var.type in ("UInt64", "Int64"):
+        return int(text)
+    values = [float(x) for x in text.split()]
+    return values if len(values) > 1 or var.dimensions else values[0]
+
+
+def scene_table(fmu, overrides):
+    """Scene name -> the values its instance is set up with."""
+    with open(os.path.join(ROOT, "modelDescription", "variables.toml"), "rb") as f:
+        import tomllib
+
+        names = list(tomllib.load(f)["scenes"])
+    table = {"default": {}}
+    for name in names:
+        table[name] = scene(name)
+    table["cloth-3d-100x100"] = dict(BIG)
+    for values in table.values():
+        values.update(PREPARED)
+        values.update(overrides)
+    for name, values in table.items():
+        unknown = [n for n in values if n not in fmu.vars]
+        if unknown:
+            raise ValueError(f"scene {name}: no variables {', '.join(unknown)}")
+    return table
+
+
+def overrides_of(fmu, sets):
+    out = {}
+    for item in sets:
+        name, eq, text = item.partition("=")
+        if not eq or name not in fmu.vars:
+            raise ValueError(f"--set {item}: NAME=VALUE with a variable of the FMU")
+        var = fmu.vars[name]
+        if var.causality not in ("parameter", "structuralParameter"):
+            raise ValueError(f"--set {name}: not a parameter ({var.causality})")
+        out[name] = parse_value(var, text)
+    return out
+
+
+class Viewer:
+    """The server and its pages (one per connected client)."""
+
+    def __init__(self, fmu_path, scene_name="default", sets=(), port=8080, fps=60.0):
+        import viser
+
+        from viewing.page import Page
+
+        self.fmu = Fmu(fmu_path)
+        self.scenes = scene_table(self.fmu, overrides_of(self.fmu, sets))
+        if scene_name not in self.scenes:
+            raise ValueError(f"--scene {scene_name}: one of {', '.join(self.scenes)}")
+        self.pages, self.lock = {}, threading.Lock()
+        self.server = viser.ViserServer(host="127.0.0.1", port=port, label="Modal mass-spring sheet", verbose=False)
+        self.port = self.server.get_port()
+
+        @self.server.on_client_connect
+        def _(client):
+            page = Page(client, self.fmu, self.scenes, scene_name, fps=fps)
+            with self.lock:
+                self.pages[client.client_id] = page
+
+        @self.server.on_client_disconnect
+        def _(client):
+            with self.lock:
+                page = self.pages.pop(client.client_id, None)
+            if page is not None:
+                page.close()
+
+    def url(self):
+        return f"http://127.0.0.1:{self.port}"
+
+    def close(self):
+        with self.lock:
+            pages, self.pages = list(self.pages.values()), {}
+        for page in pages:
+            page.close()
+        self.server.stop()
+        self.fmu.close()
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("fmu", nargs="?", default=DEFAULT_FMU, help="default: target/fmu/ModalMassSpring.fmu")
+    p.add_argument("--scene", default="default", help="the scene a page opens with (default: the FMU's start values)")
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help="a parameter on top of every scene (repeatable)")
+    p.add_argument("--port", type=int, default=8080, help="the port on 127.0.0.1 (default 8080; the next free one if taken)")
+    p.add_argument("--fps", type=float, default=60.0, help="frames a second sent to each page (default 60)")
+    p.add_argument("--no-open", action="store_true", help="do not open a browser")
+    args = p.parse_args(argv)
+    try:
+        viewer = Viewer(args.fmu, args.scene, args.set, args.port, args.fps)
+    except (ValueError, OSError) as e:
+        print(f"view: {e}", file=sys.stderr)
+        return 2
+    print(f"view: {viewer.url()} (Ctrl-C stops)", flush=True)
+    if not args.no_open:
+        webbrowser.open(viewer.url())
+    try:
+        while True:
+            time.sleep(1.0)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        viewer.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,114 @@
+"""Frame rates and latency of the live view (python/view.py) in Debian's
+Chromium, headless (software WebGL: no GPU here), per scene:
+
+- frames/s the server sends to the page and the real-time factor of its run;
+- messages/s the page receives and frames/s it draws (counted in the page);
+- control -> FMU: a weight typed into the page until the FMU has it;
+- control -> screen: Pause clicked until the page's button reads Play (the
+  round trip through the server to the page's DOM);
+- frames/s the page draws while paused (its drawing alone).
+
+    .venv/bin/python python/view_measure.py [FMU] [--scene default --scene cloth-3d-100x100] [--seconds 5] [--screenshots DIR]
+"""
+
+import argparse
+import os
+import socket
+import sys
+import time
+
+import numpy as np
+
+from view import DEFAULT_FMU, Viewer
+from viewing import clients
+
+
+def wait(condition, timeout=60.0):
+    end = time.time() + timeout
+    while time.time() < end:
+        if condition():
+            return True
+        time.sleep(0.001)
+    raise TimeoutError("the page did not come up")
+
+
+def free_port():
+    with socket.socket() as so:
+        so.bind(("127.0.0.1", 0))
+        return so.getsockname()[1]
+
+
+def measure(fmu, scene, seconds, screenshots, fps=60.0):
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
+
+    viewer = Viewer(fmu, scene, port=free_port(), fps=fps)
+    driver = clients.chromium()
+    try:
+        driver.get(viewer.url())
+        wait(lambda: viewer.pages)
+        (page,) = viewer.pages.values()
+        wait(lambda: "frames/s" in driver.find_element(By.TAG_NAME, "body").text)
+        time.sleep(2.0)
+        clients.counted(driver)
+        f0, t0, w0 = page.frames_sent, page.status()["time"], time.perf_counter()
+        time.sleep(seconds)
+        received, drawn = clients.counted(driver)
+        wall = time.perf_counter() - w0
+        row = {
+            "scene": scene,
+            "nodes": page.session.n,
+            "sent/s": (page.frames_sent - f0) / wall,
+            "real-time factor": (page.status()["time"] - t0) / wall,
+            "received/s": len(received) / wall,
+            "drawn/s": len(drawn) / wall,
+        }
+        if screenshots:
+            os.makedirs(screenshots, exist_ok=True)
+            driver.save_screenshot(os.path.join(screenshots, f"{scene}.png"))
+        # control -> FMU: a class weight typed into the page.
+        label = next(s.label for s in page.class_sliders.values() if not s.disabled)
+        box = driver.find_element(By.XPATH, f"//label[contains(., '{label}')]/following::input[not(@type='hidden')][1]")
+        box.send_keys(Keys.CONTROL, "a")
+        box.send_keys("0.5")
+        before = page.session.weights.copy()
+        start = time.perf_counter()
+        box.send_keys(Keys.ENTER)
+        wait(lambda: not np.array_equal(page.session.weights, before), timeout=10)
+        row["control -> FMU [ms]"] = 1e3 * (time.perf_counter() - start)
+        # control -> screen: Pause until the button reads Play.
+        button = driver.find_element(By.XPATH, "//button[contains(., 'Pause')]")
+        start = time.perf_counter()
+        button.click()
+        wait(lambda: driver.find_elements(By.XPATH, "//button[contains(., 'Play')]"), timeout=10)
+        row["control -> screen [ms]"] = 1e3 * (time.perf_counter() - start)
+        # Paused: the server sends the same frame on; what the page draws then is its drawing alone.
+        time.sleep(0.5)
+        clients.counted(driver)
+        time.sleep(seconds)
+        row["drawn/s paused"] = len(clients.counted(driver)[1]) / seconds
+        return row
+    finally:
+        driver.quit()
+        viewer.close()
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("fmu", nargs="?", default=DEFAULT_FMU)
+    p.add_argument("--scene", action="append", default=None, help="default: default and cloth-3d-100x100")
+    p.add_argument("--seconds", type=float, default=5.0)
+    p.add_argument("--screenshots", default=None, help="a directory for a screenshot per scene")
+    p.add_argument("--fps", type=float, default=60.0, help="frames a second the server sends (default 60)")
+    args = p.parse_args(argv)
+    rows = [measure(args.fmu, s, args.seconds, args.screenshots, args.fps) for s in args.scene or ["default", "cloth-3d-100x100"]]
+    keys = list(rows[0])
+    print("| " + " | ".join(keys) + " |")
+    print("|" + "---|" * len(keys))
+    for r in rows:
+        print("| " + " | ".join(f"{r[k]:.1f}" if isinstance(r[k], float) else str(r[k]) for k in keys) + " |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

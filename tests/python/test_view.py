@@ -1,0 +1,323 @@
+"""The live view (python/view.py, docs/view.md): one FMU instance per page,
+steered from the page, values checked before the FMU sees them.
+
+- A session alone (no server): hostile values are refused with the reason
+  and leave its run bit for bit as a twin's that never got them; weights,
+  gravity and a holder reach the FMU and change the motion.
+- The server with bare protocol clients (what a page sends, and what a
+  hostile one might): bound to 127.0.0.1 only; two pages get two instances,
+  a page that goes frees its own; a dragged holder handle moves the held
+  nodes; malformed, out-of-range and unknown messages change nothing, and the
+  instance and the server keep running.
+- Debian's Chromium, headless: the page loads and draws the sheet, a weight
+  typed into the page changes the motion (read back from the FMU), the
+  holder dragged with the mouse moves the held nodes, Pause stops the run;
+  a screenshot into $MMS_VIEW_SCREENSHOTS when set."""
+
+import math
+import os
+import socket
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from conftest import ROOT
+
+sys.path.insert(0, str(ROOT / "python"))
+from sheet import Fmu  # noqa: E402
+from view import Viewer, scene_table  # noqa: E402
+from viewing.session import Refused, Session  # noqa: E402
+
+clients = pytest.importorskip("viewing.clients", reason="viser, selenium (cargo xtask setup --for test)")
+
+
+def until(condition, timeout=20.0, every=0.05):
+    end = time.time() + timeout
+    while time.time() < end:
+        value = condition()
+        if value:
+            return value
+        time.sleep(every)
+    raise AssertionError(f"not within {timeout} s")
+
+
+@pytest.fixture(scope="module")
+def fmu(default_fmu):
+    f = Fmu(default_fmu)
+    yield f
+    f.close()
+
+
+@pytest.fixture(scope="module")
+def scenes(fmu):
+    return scene_table(fmu, {})
+
+
+def test_hostile_values_are_refused_and_change_nothing(fmu, scenes):
+    a, b = Session(fmu, scenes["paper-3d-sheet"]), Session(fmu, scenes["paper-3d-sheet"])
+    try:
+        hostile = [
+            (lambda: a.set_gravity([math.nan, -9.81, 0.0]), "gravity: not finite"),
+            (lambda: a.set_gravity([0.0, -9.81]), "gravity: 2 values where 3"),
+            (lambda: a.set_gravity("down"), "gravity: not numbers"),
+            (lambda: a.set_gravity([0.0, -1e9, 0.0]), "gravity: outside"),
+            (lambda: a.set_weights([1.0] * (a.r + 1)), "modeWeights"),
+            (lambda: a.set_weights([math.inf] * a.r), "modeWeights: not finite"),
+            (lambda: a.set_weights([-1.0] * a.r), "modeWeights: outside"),
+            (lambda: a.set_damping(-1.0, 0.0), "dampingAlpha: outside"),
+            (lambda: a.set_damping(0.0, None), "dampingBeta: not"),
+            (lambda: a.set_anchor(3, [0.0] * 3), "holder 3"),
+            (lambda: a.set_anchor(0, [1e6, 0.0, 0.0]), "holder translation: outside"),
+            (lambda: a.set_anchor(0, [0.0] * 3, [math.nan] * 3), "holder rotation: not finite"),
+            (lambda: a.set_load([1e12, 0.0, 0.0]), "point load: outside"),
+            (lambda: a.set_load({"x": 1}), "point load"),
+        ]
+        for k in range(40):
+            if k < len(hostile):
+                action, why = hostile[k]
+                with pytest.raises(Refused, match=why.replace("(", r"\(")):
+                    action()
+            a.step()
+            b.step()
+        assert a.positions().tobytes() == b.positions().tobytes()
+        assert a.readouts() == b.readouts()
+    finally:
+        a.close()
+        b.close()
+
+
+def test_adaptive_run_refuses_weights_with_the_reason(fmu, scenes):
+    s = Session(fmu, {**scenes["default"], "reduction": "adaptive"})
+    try:
+        with pytest.raises(Refused, match="only a modal run"):
+            s.set_weights(np.zeros(s.r))
+        s.step()
+    finally:
+        s.close()
+
+
+def mean_load_height(session, steps):
+    ys = []
+    for _ in range(steps):
+        session.step()
+        ys.append(session.positions()[session.load_node, 1])
+    return float(np.mean(ys))
+
+
+def test_weights_gravity_and_holder_reach_the_fmu(fmu, scenes):
+    s = Session(fmu, scenes["default"])
+    try:
+        rest = s.start[s.load_node, 1]
+        sag = rest - mean_load_height(s, 100)
+        assert sag > 1e-3
+        s.set_weights(np.zeros(s.r))
+        assert list(fmu.get(s.inst, "modeWeights", s.r)) == [0.0] * s.r
+        # Deleted modes: gravity no longer drives them, the sheet swings about its rest shape.
+        assert abs(rest - mean_load_height(s, 200)) < 0.2 * sag
+        s.set_weights(np.ones(s.r))
+        s.set_gravity([0.0, -2 * 9.81, 0.0])
+        assert list(fmu.get(s.inst, "gravity", 3)) == [0.0, -2 * 9.81, 0.0]
+        held = np.asarray(s.holders[0])
+        before = s.positions()[held].copy()
+        for k in range(1, 21):
+            s.set_anchor(0, [0.05 * k / 20, 0.0, 0.0])
+            s.step()
+        moved = s.positions()[held] - before
+        assert np.allclose(moved[:, 0], 0.05, atol=1e-12) and np.allclose(moved[:, 1], 0.0, atol=1e-12)
+    finally:
+        s.close()
+
+
+def free_port():
+    with socket.socket() as so:
+        so.bind(("127.0.0.1", 0))
+        return so.getsockname()[1]
+
+
+@pytest.fixture
+def viewer(default_fmu):
+    v = Viewer(default_fmu, "default", port=free_port(), fps=60.0)
+    yield v
+    v.close()
+
+
+def page_of(viewer, count=1):
+    pages = until(lambda: len(viewer.pages) >= count and dict(viewer.pages))
+    return list(pages.values())
+
+
+def outside_address():
+    """An address of this machine other than loopback, if it has one."""
+    out = subprocess.run(["hostname", "-I"], capture_output=True, text=True).stdout.split()
+    return next((a for a in out if ":" not in a and not a.startswith("127.")), None)
+
+
+def test_server_listens_on_loopback_only(viewer):
+    with socket.create_connection(("127.0.0.1", viewer.port), timeout=2):
+        pass
+    address = outside_address()
+    if address is None:
+        pytest.skip("no address but loopback here")
+    with pytest.raises(OSError):
+        socket.create_connection((address, viewer.port), timeout=2).close()
+
+
+def test_two_pages_two_instances_and_a_page_that_goes_frees_its_own(viewer):
+    one, two = clients.Bare(viewer.url()), clients.Bare(viewer.url())
+    try:
+        first, second = page_of(viewer, 2)
+        assert first.session is not second.session
+        until(lambda: first.status()["time"] > 0.1 and second.status()["time"] > 0.1)
+        two.close()
+        until(lambda: len(viewer.pages) == 1)
+        (stays,) = viewer.pages.values()
+        gone = second if stays is first else first
+        until(lambda: gone.session is None)
+        gone.thread.join(5)
+        assert not gone.thread.is_alive()
+        t = stays.status()["time"]
+        until(lambda: stays.status()["time"] > t + 0.1)
+    finally:
+        one.close()
+
+
+def holder_pivot(page):
+    return page.pivots[0]
+
+
+def test_dragging_a_holder_moves_its_nodes(viewer):
+    bare = clients.Bare(viewer.url())
+    try:
+        (page,) = page_of(viewer)
+        bare.read(1.0)
+        handle = until(lambda: bare.read(0.2) and bare.find("TransformControlsMessage", name="/holder1"))
+        held = np.asarray(page.session.holders[0])
+        start = page.session.start[held]
+        bare.send(clients.drag("/holder1", handle["owner"], holder_pivot(page) + np.array([0.05, 0.02, 0.0], dtype=np.float32)))
+        until(lambda: np.allclose(page.status()["anchors"][0][:2], [0.05, 0.02], atol=1e-6), timeout=10)
+        with page.lock:
+            moved = page.session.positions()[held] - start
+        assert np.allclose(moved[:, 0], 0.05, atol=1e-6) and np.allclose(moved[:, 1], 0.02, atol=1e-6)
+        force = page.status()["holder_force"]
+        assert math.isfinite(force[1]) and force[1] < 0
+    finally:
+        bare.close()
+
+
+def test_hostile_messages_are_refused_and_the_run_goes_on(viewer):
+    bare = clients.Bare(viewer.url())
+    try:
+        (page,) = page_of(viewer)
+        until(lambda: bare.read(0.2) and bare.find("GuiSliderMessage", label="|g| [m/s²]"))
+        g = bare.find("GuiSliderMessage", label="|g| [m/s²]")["uuid"]
+        weight = bare.find("GuiSliderMessage", label="in-plane (2)")["uuid"]
+        handle = bare.find("TransformControlsMessage", name="/holder1")
+        gravity = page.session.gravity.copy()
+        for message in [
+            clients.gui_update(g, "NaN"),
+            clients.gui_update(g, 1e308),
+            clients.gui_update(g, [1, 2, 3]),
+            clients.gui_update(weight, -5.0),
+            clients.gui_update("no-such-control", 3.0),
+            clients.drag("/holder1", handle["owner"], [1e9, 0.0, 0.0]),
+            clients.drag("/holder1", handle["owner"], [0.0, 0.0, 0.0], wxyz=(math.nan, 0.0, 0.0, 0.0)),
+            clients.drag("/no-such-node", handle["owner"], [0.0, 0.0, 0.0]),
+        ]:
+            bare.send(message)
+        t = page.status()["time"]
+        until(lambda: page.status()["time"] > t + 0.2)
+        status = page.status()
+        assert status["playing"] and np.array_equal(page.session.gravity, gravity)
+        assert np.all(np.abs(status["anchors"]) < 5.0) and np.all(np.isfinite(status["anchors"]))
+        assert np.all(status["weights"] >= 0.0)
+        assert any("outside" in r or "not finite" in r for r in status["refusals"]), status["refusals"]
+        # Bytes that are not a message: that connection is dropped (and its instance freed); the server goes on.
+        bare.send(b"\x00\xffnot msgpack")
+        until(lambda: not viewer.pages or page.session is None)
+        other = clients.Bare(viewer.url())
+        try:
+            (fresh,) = page_of(viewer)
+            until(lambda: fresh.status()["time"] > 0.2)
+        finally:
+            other.close()
+    finally:
+        bare.close()
+
+
+def pixels_of(png, colour, tolerance=12):
+    """Pixels of about `colour` in the drawing: left of the control panel, above the axes icon."""
+    from io import BytesIO
+
+    import matplotlib.image as mpimg
+
+    image = (mpimg.imread(BytesIO(png), format="png")[..., :3] * 255).astype(int)
+    h, w = image.shape[:2]
+    drawing = image[: h - 120, : w - 360]
+    return int(np.count_nonzero(np.all(np.abs(drawing - np.array(colour)) < tolerance, axis=-1)))
+
+
+@pytest.fixture
+def browser():
+    driver = clients.chromium()
+    yield driver
+    driver.quit()
+
+
+def test_the_page_in_chromium(viewer, browser):
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
+
+    browser.get(viewer.url())
+    (page,) = page_of(viewer)
+    until(lambda: "frames/s" in browser.find_element(By.TAG_NAME, "body").text, timeout=30)
+    time.sleep(1.0)
+    shot = browser.get_screenshot_as_png()
+    # The springs (60, 120, 200) and the held nodes (220, 40, 40) are on the screen.
+    assert pixels_of(shot, (60, 120, 200)) > 200 and pixels_of(shot, (220, 40, 40)) > 20
+    out = os.environ.get("MMS_VIEW_SCREENSHOTS")
+    if out:
+        os.makedirs(out, exist_ok=True)
+        with open(os.path.join(out, "default.png"), "wb") as f:
+            f.write(shot)
+    received, drawn = clients.counted(browser)
+    assert len(received) > 10 and len(drawn) > 10
+    rest = page.session.start[page.session.load_node, 1]
+
+    def mean_height(seconds):
+        ys, end = [], time.time() + seconds
+        while time.time() < end:
+            ys.append(page.status()["load_node"][1])
+            time.sleep(0.005)
+        return float(np.mean(ys))
+
+    sag = rest - mean_height(1.5)
+    assert sag > 1e-3
+    # Type 0 into the in-plane class's number box: both modes of the 2D sheet are deleted.
+    box = browser.find_element(By.XPATH, "//label[contains(., 'in-plane (2)')]/following::input[not(@type='hidden')][1]")
+    box.send_keys(Keys.CONTROL, "a")
+    box.send_keys("0", Keys.ENTER)
+    until(lambda: np.all(page.status()["weights"] == 0.0), timeout=10)
+    assert list(viewer.fmu.get(page.session.inst, "modeWeights", page.session.r)) == [0.0] * page.session.r
+    time.sleep(0.5)
+    assert abs(rest - mean_height(1.5)) < 0.2 * sag
+    # Drag the holder by its handle's x arrow with the mouse: the held nodes follow.
+    held = np.asarray(page.session.holders[0])
+    start = page.session.start[held]
+    arrow = page.pivots[0] + np.array([0.7 * 0.15 * page.extent, 0.0, 0.0])
+    clients.mouse_drag(browser, clients.on_screen(page.client.camera, arrow), (48, 0))
+    until(lambda: page.target[0][0] > 0.05, timeout=10)
+    time.sleep(1.0)
+    moved = page.status()["anchors"][0]
+    assert np.allclose(moved, page.target[0], atol=1e-9) and abs(moved[1]) < 1e-9
+    with page.lock:
+        x = page.session.positions()[held]
+    assert np.allclose(x[:, 0] - start[:, 0], moved[0], atol=1e-9)
+    # Pause: the page's button reads Play and the run stops.
+    browser.find_element(By.XPATH, "//button[contains(., 'Pause')]").click()
+    until(lambda: browser.find_elements(By.XPATH, "//button[contains(., 'Play')]"), timeout=10)
+    t = page.status()["time"]
+    time.sleep(0.3)
+    assert page.status()["time"] == t and not page.status()["playing"]
