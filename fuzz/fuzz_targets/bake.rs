@@ -3,10 +3,12 @@
 //! beside the `startValues.txt` of a scene, and an instance of the FMU's
 //! release library is instantiated there, initialized and stepped.
 //!
-//! Two scenes, each baked once at start by the crate's `bake` example
+//! Three scenes, each baked once at start by the crate's `bake` example
 //! (`$MMS_BAKE_EXAMPLE`, which `cargo xtask fuzz` builds): a trained basis
-//! with cubature forces, and modes of the load with a static correction
-//! linearized at the equilibrium. The first input byte chooses the scene
+//! with cubature forces, modes of the load with a static correction
+//! linearized at the equilibrium, and reduction = adaptive with cubature
+//! forces (its bake has the adaptive section: the chosen basis, the error
+//! directions, the spring sets, the poses). The first input byte chooses the scene
 //! and how the rest becomes a file:
 //! 0: the bytes as they are;
 //! 1: the bytes as the data section, behind the valid bake's header
@@ -34,9 +36,14 @@ const STEPS: usize = 5;
 const H: f64 = 0.02;
 
 /// (name, startValues.txt): small scenes, so that a refused bake's computed set-up takes milliseconds.
-const SCENES: [(&str, &str); 2] = [
+const SCENES: [(&str, &str); 3] = [
     ("trained-cubature", "nx 6\nny 5\nnModes 4\nmodeSelection 3\nforceEvaluation 2\n"),
     ("load-static-equilibrium", "nx 6\nny 5\nnModes 4\nmodeSelection 2\nstaticCorrection 1\nlinearization 2\n"),
+    // reduction = adaptive with cubature forces on a 3D sheet: the bake has its adaptive section.
+    (
+        "adaptive-cubature",
+        "nx 6\nny 6\ndimension 3\nauxStiffness 0.05\nloadColumn 3\nnModes 4\nreduction 3\nerrorTolerance 0.1\nforceEvaluation 2\ntrainingTime 0.3\n",
+    ),
 ];
 
 struct Scene {
