@@ -8,13 +8,24 @@ Chromium, headless (software WebGL: no GPU here), per scene:
   round trip through the server to the page's DOM);
 - frames/s the page draws while paused (its drawing alone).
 
+With --yardstick, also a page of three.js alone (python/viewing/yardstick.html:
+the sheet as a mesh, its positions expanded in the page from 16 modal
+coordinates each frame, updated in place), in the same browser: what a page
+of our own could draw here. three.js comes from the npm registry (`npm pack
+three`, into target/view-yardstick/).
+
     .venv/bin/python python/view_measure.py [FMU] [--scene default --scene cloth-3d-100x100] [--seconds 5] [--screenshots DIR]
 """
 
 import argparse
+import functools
+import http.server
 import os
 import socket
+import subprocess
 import sys
+import tarfile
+import threading
 import time
 
 import numpy as np
@@ -93,6 +104,43 @@ def measure(fmu, scene, seconds, screenshots, fps=60.0):
         viewer.close()
 
 
+YARDSTICK = os.path.join(os.path.dirname(os.path.abspath(__file__)), "viewing", "yardstick.html")
+
+
+def three_js(root):
+    """three.js unpacked under `root`/three (from the npm registry, once)."""
+    if not os.path.exists(os.path.join(root, "three", "build", "three.module.js")):
+        os.makedirs(root, exist_ok=True)
+        name = subprocess.run(["npm", "pack", "three", "--silent"], cwd=root, check=True, capture_output=True, text=True).stdout.split()[-1]
+        with tarfile.open(os.path.join(root, name)) as tar:
+            tar.extractall(root, filter="data")
+        os.replace(os.path.join(root, "package"), os.path.join(root, "three"))
+    with open(YARDSTICK) as f, open(os.path.join(root, "yardstick.html"), "w") as g:
+        g.write(f.read())
+    return root
+
+
+def yardstick(root, n, seconds, antialias):
+    """Frames/s the yardstick page draws of an n x n sheet."""
+    class Quiet(http.server.SimpleHTTPRequestHandler):
+        def log_message(self, *_):
+            pass
+
+    handler = functools.partial(Quiet, directory=root)
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    driver = clients.chromium()
+    try:
+        driver.get(f"http://127.0.0.1:{server.server_address[1]}/yardstick.html?n={n}&r=16&antialias={int(antialias)}")
+        time.sleep(2.0)
+        driver.execute_script("window.__drawn.splice(0)")
+        time.sleep(seconds)
+        return len(driver.execute_script("return window.__drawn.splice(0)")) / seconds
+    finally:
+        driver.quit()
+        server.shutdown()
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("fmu", nargs="?", default=DEFAULT_FMU)
@@ -100,6 +148,7 @@ def main(argv=None):
     p.add_argument("--seconds", type=float, default=5.0)
     p.add_argument("--screenshots", default=None, help="a directory for a screenshot per scene")
     p.add_argument("--fps", type=float, default=60.0, help="frames a second the server sends (default 60)")
+    p.add_argument("--yardstick", action="store_true", help="also three.js alone, expanding the modes in the page (npm)")
     args = p.parse_args(argv)
     rows = [measure(args.fmu, s, args.seconds, args.screenshots, args.fps) for s in args.scene or ["default", "cloth-3d-100x100"]]
     keys = list(rows[0])
@@ -107,6 +156,12 @@ def main(argv=None):
     print("|" + "---|" * len(keys))
     for r in rows:
         print("| " + " | ".join(f"{r[k]:.1f}" if isinstance(r[k], float) else str(r[k]) for k in keys) + " |")
+    if args.yardstick:
+        root = three_js(os.path.join(os.path.dirname(DEFAULT_FMU), "..", "view-yardstick"))
+        print("\nthree.js alone, modes expanded in the page (16 modes, a mesh updated in place):\n")
+        print("| nodes | drawn/s, antialiased | drawn/s, without antialiasing |\n|---|---|---|")
+        for n in (10, 30, 100):
+            print(f"| {n * n} | {yardstick(root, n, args.seconds, True):.1f} | {yardstick(root, n, args.seconds, False):.1f} |")
     return 0
 
 
