@@ -27,6 +27,8 @@ PULL_LENGTH = 0.1
 HOLDER_SPEED = 1.0
 HOLDER_LAG = 0.05
 MODE_SLIDERS = 24
+# Modes the gallery shows at once.
+GALLERY = 6
 CLASSES = ("in-plane", "out-of-plane", "symmetric", "antisymmetric")
 
 
@@ -147,7 +149,9 @@ class Page:
         self.load_handle = scene.add_transform_controls("/pull", scale=0.08 * extent, position=x[s.load_node], disable_rotations=True)
         self.load_handle.on_update(lambda e: self._set_dragging(e.phase != "end"))
         self.extent = extent
-        self.ghost = None
+        for node in getattr(self, "ghosts", []):
+            node.remove()
+        self.ghosts, self.shapes = [], None
         # The camera on the sheet: square on for a 2D sheet, from the front and above one side for 3D.
         center = x.mean(axis=0)
         view = np.array([0.0, 0.0, 2.2]) if s.dim == 2 else np.array([1.1, 0.5, 1.6])
@@ -192,8 +196,8 @@ class Page:
                 self.mode_sliders.append(slider)
         with gui.add_folder("Mode gallery") as folder:
             self.gui_nodes.append(folder)
-            self.gallery = gui.add_slider("show mode (0: none)", 0, s.r, 1, 0)
-            self.gallery.on_update(lambda _: self._show_mode(int(self.gallery.value)))
+            self.gallery = gui.add_slider(f"from mode (0: none; {GALLERY} shown)", 0, s.r, 1, 0)
+            self.gallery.on_update(lambda _: self._guarded(lambda: self._show_modes(int(self.gallery.value))))
 
     # ---- controls -----------------------------------------------------
 
@@ -281,21 +285,31 @@ class Page:
             if not on:
                 self._guarded(lambda: self.session.set_load(np.zeros(3)))
 
-    def _show_mode(self, j):
+    def _show_modes(self, first):
+        """Modes first .. first + GALLERY - 1 (modeShapes), each at 0.45 of the sheet's size in a grid beside it,
+        with its frequency; 0: none."""
         s = self.session
-        if self.ghost is not None:
-            self.ghost.remove()
-            self.ghost = None
-        if not 1 <= j <= s.r:
+        for node in self.ghosts:
+            node.remove()
+        self.ghosts = []
+        if not 1 <= first <= s.r:
             return
-        phi = s.mode_shapes()[j - 1]
-        scale = 0.25 * self.extent / (np.abs(phi).max() or 1.0)
-        x = as3(s.start + scale * phi) + np.array([1.2 * self.extent, 0.0, 0.0], dtype=np.float32)
-        label = f"/mode {j}: {s.frequencies[j - 1]:.2f} Hz"
-        if self.big:
-            self.ghost = self.client.scene.add_mesh_simple(label, x, self.faces, color=(150, 150, 150), side="double")
-        else:
-            self.ghost = self.client.scene.add_line_segments(label, x[s.springs], (150, 150, 150), thickness=0.003)
+        if self.shapes is None:
+            self.shapes = s.mode_shapes()
+        for k, j in enumerate(range(first, min(first + GALLERY, s.r + 1))):
+            phi = self.shapes[j - 1]
+            scale = 0.2 * self.extent / (np.abs(phi).max() or 1.0)
+            # Left of the sheet (the control panel covers the right of the page), three to a row.
+            center = as3(s.start).mean(axis=0)
+            at = center + np.array([-(2.25 - 0.62 * (k % 3)) * self.extent, 0.25 * self.extent - 0.65 * self.extent * (k // 3), 0.0], dtype=np.float32)
+            x = 0.45 * (as3(s.start + scale * phi) - center) + at
+            name = f"/gallery/mode {j}"
+            if self.big:
+                self.ghosts.append(self.client.scene.add_mesh_simple(name, x, self.faces, color=(150, 150, 150), side="double"))
+            else:
+                self.ghosts.append(self.client.scene.add_line_segments(name, x[s.springs], (150, 150, 150), thickness=0.002))
+            top = at + np.array([0.0, 0.28 * self.extent, 0.0], dtype=np.float32)
+            self.ghosts.append(self.client.scene.add_label(f"/gallery/label {j}", f"mode {j}: {s.frequencies[j - 1]:.2f} Hz", position=top))
 
     # ---- stepping -----------------------------------------------------
 

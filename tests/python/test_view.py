@@ -247,6 +247,22 @@ def test_hostile_messages_are_refused_and_the_run_goes_on(viewer):
         bare.close()
 
 
+def test_the_mode_gallery_draws_six_modes_beside_the_sheet(viewer):
+    bare = clients.Bare(viewer.url())
+    try:
+        (page,) = page_of(viewer)
+        gallery = until(lambda: bare.read(0.2) and bare.find("GuiSliderMessage", label="from mode (0: none; 6 shown)"))
+        bare.send(clients.gui_update(gallery["uuid"], 1))
+        until(lambda: len(page.ghosts) == 2 * min(6, page.session.r))
+        bare.read(0.5)
+        names = {m.get("name") for m in bare.seen}
+        assert {f"/gallery/mode {j}" for j in range(1, page.session.r + 1)} <= names
+        bare.send(clients.gui_update(gallery["uuid"], 0))
+        until(lambda: page.ghosts == [])
+    finally:
+        bare.close()
+
+
 def pixels_of(png, colour, tolerance=12):
     """Pixels of about `colour` in the drawing: left of the control panel, above the axes icon."""
     from io import BytesIO
