@@ -15,7 +15,9 @@ modal basis of load modes holds the holders' motion.
 
 Each page gets its own FMU instance (freed when the page closes); a value a
 page sends is checked before the FMU sees it and a refused one is shown on
-the page with the reason, the instance keeping its last good state.
+the page with the reason, the instance keeping its last good state; bytes that are not a
+message of viser's protocol are refused (viewing/protocol.py) and the page
+goes on.
 """
 
 import argparse
@@ -87,7 +89,10 @@ class Viewer:
     def __init__(self, fmu_path, scene_name="default", sets=(), port=8080, fps=60.0):
         import viser
 
+        from viewing import protocol
         from viewing.page import Page
+
+        protocol.guard()
 
         self.fmu = Fmu(fmu_path)
         self.scenes = scene_table(self.fmu, overrides_of(self.fmu, sets))

@@ -91,6 +91,11 @@ def encode(message):
     return msgspec.msgpack.encode(message.as_serializable_dict())
 
 
+def packed(fields):
+    """Any dict as a page would pack a message (msgpack), whether or not viser knows it."""
+    return msgspec.msgpack.encode(fields)
+
+
 def decode(raw):
     size, packed = int.from_bytes(raw[:8], "little"), int.from_bytes(raw[8:16], "little")
     inner = zstandard.ZstdDecompressor().decompress(raw[16 : 16 + packed], max_output_size=size)

@@ -7,8 +7,8 @@ steered from the page, values checked before the FMU sees them.
 - The server with bare protocol clients (what a page sends, and what a
   hostile one might): bound to 127.0.0.1 only; two pages get two instances,
   a page that goes frees its own; a dragged holder handle moves the held
-  nodes; malformed, out-of-range and unknown messages change nothing, and the
-  instance and the server keep running.
+  nodes; malformed, out-of-range and unknown messages and bytes that are not
+  messages change nothing, and the instance and the server keep running.
 - Debian's Chromium, headless: the page loads and draws the sheet, a weight
   typed into the page changes the motion (read back from the FMU), the
   holder dragged with the mouse moves the held nodes, Pause stops the run;
@@ -234,12 +234,16 @@ def test_hostile_messages_are_refused_and_the_run_goes_on(viewer):
         assert np.all(np.abs(status["anchors"]) < 5.0) and np.all(np.isfinite(status["anchors"]))
         assert np.all(status["weights"] >= 0.0)
         assert any("outside" in r or "not finite" in r for r in status["refusals"]), status["refusals"]
-        # Bytes that are not a message: that connection is dropped (and its instance freed); the server goes on.
+        # Bytes that are not a message, and text: refused; the page, its instance and the server go on.
         bare.send(b"\x00\xffnot msgpack")
-        until(lambda: not viewer.pages or page.session is None)
+        bare.ws.send("text, not bytes")
+        bare.send(clients.packed({"type": "NoSuchMessage"}))
+        t = page.status()["time"]
+        until(lambda: page.status()["time"] > t + 0.2)
+        assert list(viewer.pages.values()) == [page] and page.session is not None
         other = clients.Bare(viewer.url())
         try:
-            (fresh,) = page_of(viewer)
+            fresh = next(p for p in page_of(viewer, 2) if p is not page)
             until(lambda: fresh.status()["time"] > 0.2)
         finally:
             other.close()
