@@ -21,7 +21,6 @@ import argparse
 import functools
 import http.server
 import os
-import socket
 import subprocess
 import sys
 import tarfile
@@ -34,32 +33,17 @@ from view import DEFAULT_FMU, Viewer
 from viewing import clients
 
 
-def wait(condition, timeout=60.0):
-    end = time.time() + timeout
-    while time.time() < end:
-        if condition():
-            return True
-        time.sleep(0.001)
-    raise TimeoutError("the page did not come up")
-
-
-def free_port():
-    with socket.socket() as so:
-        so.bind(("127.0.0.1", 0))
-        return so.getsockname()[1]
-
-
 def measure(fmu, scene, seconds, screenshots, fps=60.0):
     from selenium.webdriver.common.by import By
     from selenium.webdriver.common.keys import Keys
 
-    viewer = Viewer(fmu, scene, port=free_port(), fps=fps)
+    viewer = Viewer(fmu, scene, port=clients.free_port(), fps=fps)
     driver = clients.chromium()
     try:
         driver.get(viewer.url())
-        wait(lambda: viewer.pages)
+        clients.until(lambda: viewer.pages, timeout=60)
         (page,) = viewer.pages.values()
-        wait(lambda: "frames/s" in driver.find_element(By.TAG_NAME, "body").text)
+        clients.until(lambda: "frames/s" in driver.find_element(By.TAG_NAME, "body").text, timeout=60)
         time.sleep(2.0)
         clients.counted(driver)
         f0, t0, w0 = page.frames_sent, page.status()["time"], time.perf_counter()
@@ -85,13 +69,13 @@ def measure(fmu, scene, seconds, screenshots, fps=60.0):
         before = page.session.weights.copy()
         start = time.perf_counter()
         box.send_keys(Keys.ENTER)
-        wait(lambda: not np.array_equal(page.session.weights, before), timeout=10)
+        clients.until(lambda: not np.array_equal(page.session.weights, before), timeout=10)
         row["control -> FMU [ms]"] = 1e3 * (time.perf_counter() - start)
         # control -> screen: Pause until the button reads Play.
         button = driver.find_element(By.XPATH, "//button[contains(., 'Pause')]")
         start = time.perf_counter()
         button.click()
-        wait(lambda: driver.find_elements(By.XPATH, "//button[contains(., 'Play')]"), timeout=10)
+        clients.until(lambda: driver.find_elements(By.XPATH, "//button[contains(., 'Play')]"), timeout=10)
         row["control -> screen [ms]"] = 1e3 * (time.perf_counter() - start)
         # Paused: the server sends the same frame on; what the page draws then is its drawing alone.
         time.sleep(0.5)

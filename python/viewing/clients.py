@@ -8,6 +8,7 @@ plus "type"; the server sends windows of messages as
 [8-byte size][8-byte compressed size][zstd msgpack {"messages": [...]}][binary buffers]."""
 
 import shutil
+import socket
 import time
 
 import msgspec
@@ -19,6 +20,24 @@ from websockets.sync.client import connect
 
 CHROMIUM = ("/usr/bin/chromium", "/usr/bin/chromium-browser")
 DRIVER = ("/usr/bin/chromedriver", "/usr/lib/chromium/chromedriver")
+
+
+def until(condition, timeout=20.0, every=0.005):
+    """The first true value of `condition()`, polled; TimeoutError after `timeout` seconds."""
+    end = time.time() + timeout
+    while time.time() < end:
+        value = condition()
+        if value:
+            return value
+        time.sleep(every)
+    raise TimeoutError(f"not within {timeout} s")
+
+
+def free_port():
+    """A port on 127.0.0.1 free now."""
+    with socket.socket() as so:
+        so.bind(("127.0.0.1", 0))
+        return so.getsockname()[1]
 
 
 def find(paths, name):
@@ -56,21 +75,16 @@ def chromium(width=1280, height=800):
 # every frame it draws (performance.now() in ms), from before viser's client loads.
 COUNTERS = """
 window.__received = []; window.__drawn = [];
-const OpenSocket = window.WebSocket;
-window.WebSocket = function (...args) {
-  const socket = new OpenSocket(...args);
-  socket.addEventListener("message", () => window.__received.push(performance.now()));
-  return socket;
-};
-window.WebSocket.prototype = OpenSocket.prototype;
-Object.assign(window.WebSocket, OpenSocket);
-const OpenWorker = window.Worker;
-window.Worker = function (...args) {
-  const worker = new OpenWorker(...args);
-  worker.addEventListener("message", () => window.__received.push(performance.now()));
-  return worker;
-};
-window.Worker.prototype = OpenWorker.prototype;
+for (const name of ["WebSocket", "Worker"]) {
+  const Open = window[name];
+  window[name] = function (...args) {
+    const opened = new Open(...args);
+    opened.addEventListener("message", () => window.__received.push(performance.now()));
+    return opened;
+  };
+  window[name].prototype = Open.prototype;
+  Object.assign(window[name], Open);
+}
 const draw = () => { window.__drawn.push(performance.now()); requestAnimationFrame(draw); };
 requestAnimationFrame(draw);
 """

@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from viewing.session import Clock, Refused, Session, prefix
+from viewing.session import STRONGEST_PULL, Clock, Refused, Session
 
 LINE_NODES = 2500
 PULL_LENGTH = 0.1
@@ -79,7 +79,6 @@ class Page:
         self.frames_sent, self.rate, self.rtf = 0, 0.0, 0.0
         self.session = None
         self.gui_nodes = []
-        self.controls_folder = None
         self._build_run_panel(scene_name)
         self.start(scene_name)
         self.thread = threading.Thread(target=self._loop, name=f"page-{client.client_id}", daemon=True)
@@ -272,12 +271,9 @@ class Page:
         turn = rotation_vector(handle.wxyz)
         with self.lock:
             try:
-                self.session._checked("holder translation", offset, -5.0, 5.0, 3)
-                self.session._checked("holder rotation", turn, -7.0, 7.0, 3)
+                self.target[k] = self.session.checked_anchor(k, offset, turn)
             except Refused as e:
                 self.refuse(str(e))
-                return
-            self.target[k] = np.concatenate([offset, turn])
 
     def _set_dragging(self, on):
         with self.lock:
@@ -328,7 +324,7 @@ class Page:
             x = s.positions()[s.load_node]
             pull = np.zeros(3)
             pull[: s.dim] = (np.asarray(self.load_handle.position)[: s.dim] - x) * (s.weight / PULL_LENGTH)
-            limit = 0.9 * 50.0 * s.weight
+            limit = 0.9 * STRONGEST_PULL * s.weight
             norm = np.linalg.norm(pull)
             s.set_load(pull * min(1.0, limit / norm) if norm > 0 else pull)
 
@@ -360,7 +356,7 @@ class Page:
                 self.load_handle.position = x[s.load_node]
         self.frames_sent += 1
 
-    def _read_out(self, wall, sim):
+    def _read_out(self):
         s = self.session
         r = s.readouts()
         lines = [
@@ -393,7 +389,7 @@ class Page:
                 if now - mark >= 0.5:
                     self.rate = (self.frames_sent - frames0) / (now - mark)
                     self.rtf = (self.session.time - sim0) / (now - mark) if self.playing else 0.0
-                    self._read_out(now, self.session.time)
+                    self._read_out()
                     mark, frames0, sim0 = now, self.frames_sent, self.session.time
             next_frame += period
             delay = next_frame - time.perf_counter()
@@ -429,5 +425,3 @@ class Page:
                 "holder_force": s.readouts()["holder 1 force"] if s else None,
             }
 
-
-__all__ = ["Page", "prefix"]

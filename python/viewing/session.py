@@ -12,8 +12,6 @@ the run at the last good state."""
 import ctypes
 import math
 import time
-from dataclasses import dataclass, field
-
 import numpy as np
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi3 import FMU3Slave, fmi3Float64, fmi3ValueReference
@@ -32,15 +30,6 @@ STATUS = ["OK", "Warning", "Discard", "Error", "Fatal"]
 
 class Refused(ValueError):
     """A value the page sent that the session did not pass on (the reason is the message)."""
-
-
-@dataclass
-class Frame:
-    """What a page draws and reads out after a step."""
-
-    time: float
-    positions: np.ndarray
-    readouts: dict = field(default_factory=dict)
 
 
 def holders_of(values, nx, ny, n_holders, holder_of_node):
@@ -124,7 +113,6 @@ class Session:
         self.time = 0.0
         self.anchors = np.zeros((self.n_holders, 6))
         self.load = np.zeros(3)
-        self.steps = 0
 
     def _read(self, vrs, out):
         ptr = out.ctypes.data_as(ctypes.POINTER(fmi3Float64))
@@ -180,14 +168,18 @@ class Session:
         self._apply("dampingBeta", b)
         self.damping = [float(a[0]), float(b[0])]
 
-    def set_anchor(self, k, translation, rotation=(0.0, 0.0, 0.0)):
-        """Holder k (0-based) displaced by `translation` and turned by the rotation vector `rotation`
-        from rest; the FMU moves it there over the next step."""
+    def checked_anchor(self, k, translation, rotation=(0.0, 0.0, 0.0)):
+        """Holder k's (0-based) translation and rotation vector, checked: the six anchor inputs."""
         if not (isinstance(k, int) and 0 <= k < self.n_holders):
             raise Refused(f"holder {k!r}: the scene has {self.n_holders}")
         t = self._checked("holder translation", translation, -FARTHEST_ANCHOR, FARTHEST_ANCHOR, 3)
         r = self._checked("holder rotation", rotation, -4 * math.pi, 4 * math.pi, 3)
-        self.anchors[k] = np.concatenate([t, r])
+        return np.concatenate([t, r])
+
+    def set_anchor(self, k, translation, rotation=(0.0, 0.0, 0.0)):
+        """Holder k (0-based) displaced by `translation` and turned by the rotation vector `rotation`
+        from rest; the FMU moves it there over the next step."""
+        self.anchors[k] = self.checked_anchor(k, translation, rotation)
 
     def set_load(self, force):
         """The point load on the load node [N]."""
@@ -212,7 +204,6 @@ class Session:
             last = self.messages[-1][2] if self.messages else str(e)
             raise Refused(f"step at t = {self.time:.3f} s refused: {last}") from None
         self.time += self.h
-        self.steps += 1
 
     def readouts(self):
         """The energies, the error indicators and each holder's force, in one Get."""
@@ -221,9 +212,6 @@ class Session:
         for k in range(self.n_holders):
             out[f"holder {k + 1} force"] = [v[prefix(k) + f"Force{a}"] for a in "XYZ"]
         return out
-
-    def frame(self):
-        return Frame(self.time, self.positions(), self.readouts())
 
     def close(self):
         if not self.closed:

@@ -34,16 +34,6 @@ from viewing.session import Refused, Session  # noqa: E402
 clients = pytest.importorskip("viewing.clients", reason="viser, selenium (cargo xtask setup --for test)")
 
 
-def until(condition, timeout=20.0, every=0.05):
-    end = time.time() + timeout
-    while time.time() < end:
-        value = condition()
-        if value:
-            return value
-        time.sleep(every)
-    raise AssertionError(f"not within {timeout} s")
-
-
 @pytest.fixture(scope="module")
 def fmu(default_fmu):
     f = Fmu(default_fmu)
@@ -131,21 +121,15 @@ def test_weights_gravity_and_holder_reach_the_fmu(fmu, scenes):
         s.close()
 
 
-def free_port():
-    with socket.socket() as so:
-        so.bind(("127.0.0.1", 0))
-        return so.getsockname()[1]
-
-
 @pytest.fixture
 def viewer(default_fmu):
-    v = Viewer(default_fmu, "default", port=free_port(), fps=60.0)
+    v = Viewer(default_fmu, "default", port=clients.free_port(), fps=60.0)
     yield v
     v.close()
 
 
 def page_of(viewer, count=1):
-    pages = until(lambda: len(viewer.pages) >= count and dict(viewer.pages))
+    pages = clients.until(lambda: len(viewer.pages) >= count and dict(viewer.pages))
     return list(pages.values())
 
 
@@ -170,16 +154,16 @@ def test_two_pages_two_instances_and_a_page_that_goes_frees_its_own(viewer):
     try:
         first, second = page_of(viewer, 2)
         assert first.session is not second.session
-        until(lambda: first.status()["time"] > 0.1 and second.status()["time"] > 0.1)
+        clients.until(lambda: first.status()["time"] > 0.1 and second.status()["time"] > 0.1)
         two.close()
-        until(lambda: len(viewer.pages) == 1)
+        clients.until(lambda: len(viewer.pages) == 1)
         (stays,) = viewer.pages.values()
         gone = second if stays is first else first
-        until(lambda: gone.session is None)
+        clients.until(lambda: gone.session is None)
         gone.thread.join(5)
         assert not gone.thread.is_alive()
         t = stays.status()["time"]
-        until(lambda: stays.status()["time"] > t + 0.1)
+        clients.until(lambda: stays.status()["time"] > t + 0.1)
     finally:
         one.close()
 
@@ -193,11 +177,11 @@ def test_dragging_a_holder_moves_its_nodes(viewer):
     try:
         (page,) = page_of(viewer)
         bare.read(1.0)
-        handle = until(lambda: bare.read(0.2) and bare.find("TransformControlsMessage", name="/holder1"))
+        handle = clients.until(lambda: bare.read(0.2) and bare.find("TransformControlsMessage", name="/holder1"))
         held = np.asarray(page.session.holders[0])
         start = page.session.start[held]
         bare.send(clients.drag("/holder1", handle["owner"], holder_pivot(page) + np.array([0.05, 0.02, 0.0], dtype=np.float32)))
-        until(lambda: np.allclose(page.status()["anchors"][0][:2], [0.05, 0.02], atol=1e-6), timeout=10)
+        clients.until(lambda: np.allclose(page.status()["anchors"][0][:2], [0.05, 0.02], atol=1e-6), timeout=10)
         with page.lock:
             moved = page.session.positions()[held] - start
         assert np.allclose(moved[:, 0], 0.05, atol=1e-6) and np.allclose(moved[:, 1], 0.02, atol=1e-6)
@@ -211,7 +195,7 @@ def test_hostile_messages_are_refused_and_the_run_goes_on(viewer):
     bare = clients.Bare(viewer.url())
     try:
         (page,) = page_of(viewer)
-        until(lambda: bare.read(0.2) and bare.find("GuiSliderMessage", label="|g| [m/s²]"))
+        clients.until(lambda: bare.read(0.2) and bare.find("GuiSliderMessage", label="|g| [m/s²]"))
         g = bare.find("GuiSliderMessage", label="|g| [m/s²]")["uuid"]
         weight = bare.find("GuiSliderMessage", label="in-plane (2)")["uuid"]
         handle = bare.find("TransformControlsMessage", name="/holder1")
@@ -228,7 +212,7 @@ def test_hostile_messages_are_refused_and_the_run_goes_on(viewer):
         ]:
             bare.send(message)
         t = page.status()["time"]
-        until(lambda: page.status()["time"] > t + 0.2)
+        clients.until(lambda: page.status()["time"] > t + 0.2)
         status = page.status()
         assert status["playing"] and np.array_equal(page.session.gravity, gravity)
         assert np.all(np.abs(status["anchors"]) < 5.0) and np.all(np.isfinite(status["anchors"]))
@@ -239,12 +223,12 @@ def test_hostile_messages_are_refused_and_the_run_goes_on(viewer):
         bare.ws.send("text, not bytes")
         bare.send(clients.packed({"type": "NoSuchMessage"}))
         t = page.status()["time"]
-        until(lambda: page.status()["time"] > t + 0.2)
+        clients.until(lambda: page.status()["time"] > t + 0.2)
         assert list(viewer.pages.values()) == [page] and page.session is not None
         other = clients.Bare(viewer.url())
         try:
             fresh = next(p for p in page_of(viewer, 2) if p is not page)
-            until(lambda: fresh.status()["time"] > 0.2)
+            clients.until(lambda: fresh.status()["time"] > 0.2)
         finally:
             other.close()
     finally:
@@ -255,14 +239,14 @@ def test_the_mode_gallery_draws_six_modes_beside_the_sheet(viewer):
     bare = clients.Bare(viewer.url())
     try:
         (page,) = page_of(viewer)
-        gallery = until(lambda: bare.read(0.2) and bare.find("GuiSliderMessage", label="from mode (0: none; 6 shown)"))
+        gallery = clients.until(lambda: bare.read(0.2) and bare.find("GuiSliderMessage", label="from mode (0: none; 6 shown)"))
         bare.send(clients.gui_update(gallery["uuid"], 1))
-        until(lambda: len(page.ghosts) == 2 * min(6, page.session.r))
+        clients.until(lambda: len(page.ghosts) == 2 * min(6, page.session.r))
         bare.read(0.5)
         names = {m.get("name") for m in bare.seen}
         assert {f"/gallery/mode {j}" for j in range(1, page.session.r + 1)} <= names
         bare.send(clients.gui_update(gallery["uuid"], 0))
-        until(lambda: page.ghosts == [])
+        clients.until(lambda: page.ghosts == [])
     finally:
         bare.close()
 
@@ -292,7 +276,7 @@ def test_the_page_in_chromium(viewer, browser):
 
     browser.get(viewer.url())
     (page,) = page_of(viewer)
-    until(lambda: "frames/s" in browser.find_element(By.TAG_NAME, "body").text, timeout=30)
+    clients.until(lambda: "frames/s" in browser.find_element(By.TAG_NAME, "body").text, timeout=30)
     time.sleep(1.0)
     shot = browser.get_screenshot_as_png()
     # The springs (60, 120, 200) and the held nodes (220, 40, 40) are on the screen.
@@ -319,7 +303,7 @@ def test_the_page_in_chromium(viewer, browser):
     box = browser.find_element(By.XPATH, "//label[contains(., 'in-plane (2)')]/following::input[not(@type='hidden')][1]")
     box.send_keys(Keys.CONTROL, "a")
     box.send_keys("0", Keys.ENTER)
-    until(lambda: np.all(page.status()["weights"] == 0.0), timeout=10)
+    clients.until(lambda: np.all(page.status()["weights"] == 0.0), timeout=10)
     assert list(viewer.fmu.get(page.session.inst, "modeWeights", page.session.r)) == [0.0] * page.session.r
     time.sleep(0.5)
     assert abs(rest - mean_height(1.5)) < 0.2 * sag
@@ -328,7 +312,7 @@ def test_the_page_in_chromium(viewer, browser):
     start = page.session.start[held]
     arrow = page.pivots[0] + np.array([0.7 * 0.15 * page.extent, 0.0, 0.0])
     clients.mouse_drag(browser, clients.on_screen(page.client.camera, arrow), (48, 0))
-    until(lambda: page.target[0][0] > 0.05, timeout=10)
+    clients.until(lambda: page.target[0][0] > 0.05, timeout=10)
     time.sleep(1.0)
     moved = page.status()["anchors"][0]
     assert np.allclose(moved, page.target[0], atol=1e-9) and abs(moved[1]) < 1e-9
@@ -337,7 +321,7 @@ def test_the_page_in_chromium(viewer, browser):
     assert np.allclose(x[:, 0] - start[:, 0], moved[0], atol=1e-9)
     # Pause: the page's button reads Play and the run stops.
     browser.find_element(By.XPATH, "//button[contains(., 'Pause')]").click()
-    until(lambda: browser.find_elements(By.XPATH, "//button[contains(., 'Play')]"), timeout=10)
+    clients.until(lambda: browser.find_elements(By.XPATH, "//button[contains(., 'Play')]"), timeout=10)
     t = page.status()["time"]
     time.sleep(0.3)
     assert page.status()["time"] == t and not page.status()["playing"]
