@@ -5,12 +5,13 @@
 //! basis size every 0.1 s, and the run time against full space
 //! (`docs/method.md`, section 10).
 //!
-//! `cargo run --release --example adaptive_probe -- [N] [TOLERANCE]` (`ONLY=case` runs one case)
+//! `cargo run --release --example adaptive_probe -- [N] [TOLERANCE]` (`ONLY=case` runs one case,
+//! `STEPS=k` k steps instead of 60, `STEP=h` steps of h s instead of 0.01, `CUBATURE=1` cubature
+//! forces, `TRACE=case` every step with its forceResidual, `FINE=h` full space at internal steps of h)
 
 use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::physics::*;
 use std::time::Instant;
-const H: f64 = 0.01;
 fn gravity(scale: f64, x_deg: f64, z_deg: f64) -> [f64; 3] {
     let (a, b) = (x_deg.to_radians(), z_deg.to_radians());
     let g = [9.81 * b.sin(), -9.81 * b.cos(), 0.0];
@@ -19,6 +20,8 @@ fn gravity(scale: f64, x_deg: f64, z_deg: f64) -> [f64; 3] {
 }
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    #[allow(non_snake_case)]
+    let H: f64 = std::env::var("STEP").ok().map_or(0.01, |v| v.parse().unwrap());
     let nx: usize = args.get(0).map_or(30, |v| v.parse().unwrap());
     let tol: f64 = args.get(1).map_or(0.01, |v| v.parse().unwrap());
     let mut base = canonical_scenes::cloth(nx, nx);
@@ -63,7 +66,8 @@ fn main() {
         }
         let (mut num, mut den) = (0.0, 0.0);
         let (mut tf, mut tm) = (0.0, 0.0);
-        for k in 1..=60 {
+        let steps: usize = std::env::var("STEPS").ok().map_or(60, |v| v.parse().unwrap());
+        for k in 1..=steps {
             let t = Instant::now();
             f.do_step(H).unwrap();
             tf += t.elapsed().as_secs_f64();
@@ -80,13 +84,14 @@ fn main() {
                 let e = xf.iter().zip(&xm).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
                 let d = xf.iter().zip(&x0).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
                 println!(
-                    "  t {:.2} e {e:.4} d {d:.3} e/d {:.4} E {:.4} est {:.4} basis {} step {:.3} ms",
+                    "  t {:.2} e {e:.4} d {d:.3} e/d {:.4} E {:.4} est {:.4} basis {} step {:.3} ms fr {:.3}",
                     k as f64 * H,
                     e / d,
                     (num / den).sqrt(),
                     st.error_estimate,
                     st.basis_size,
-                    dt * 1e3
+                    dt * 1e3,
+                    m.force_residual()
                 );
             }
             if k % 10 == 0 {

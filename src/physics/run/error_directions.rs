@@ -35,11 +35,16 @@
 //! out: the error outside Φ and Ψ, the cubature's own error, and what the
 //! full-space model leaves out (the error of the coordinates the basis
 //! holds, a holder's inertial loads, buckling, full space's step error).
+//! The first it cannot estimate, but it can see the force that drives it:
+//! [`DirectionModel::seen_sq`] gives the part of the full residual r
+//! in the span of M Ψ, hence the part outside it (one pass over every spring), and an adaptive
+//! run does not trust the model where that part is large.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::{cholesky_in_place, cholesky_in_place_scratch, LltRegularization};
 use faer::linalg::cholesky::llt::solve::solve_in_place_with_conj;
-use faer::{Conj, MatMut, MatRef, Par};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Conj, MatMut, MatRef, Par};
 
 use crate::physics::error::PhysicsError;
 use crate::physics::run::error_model::{ErrorState, BETA};
@@ -110,6 +115,8 @@ pub struct DirectionModel {
     factor: Vec<f64>,
     forcing: Vec<f64>,
     rhs: Vec<f64>,
+    /// Ψᵀ f of [`Self::seen_sq`].
+    seen: Vec<f64>,
     /// G_e of one spring (D x k) and K_e G_e.
     g: Vec<f64>,
     kg: Vec<f64>,
@@ -149,6 +156,7 @@ impl DirectionModel {
             c: vec![0.0; k * k],
             factor: vec![0.0; k * k],
             forcing: vec![0.0; k],
+            seen: vec![0.0; k],
             rhs: vec![0.0; k],
             g: vec![0.0; 3 * k],
             kg: vec![0.0; 3 * k],
@@ -190,6 +198,18 @@ impl DirectionModel {
                 }
             }
         }
+    }
+
+    /// |Ψᵀ f|² of a force `f` on the free DOFs, by faer's n k product
+    /// (nothing is allocated). Since Ψ is M-orthonormal, M Ψ Ψᵀ f is f's
+    /// M⁻¹-orthogonal projection on the span of M Ψ, of size |Ψᵀ f|.
+    pub fn seen_sq(&mut self, f: &[f64]) -> f64 {
+        let (n, k) = (self.n, self.k);
+        // Ψ row-major n x k is Ψᵀ column-major k x n.
+        let psi_t = MatRef::from_column_major_slice(&self.psi, k, n);
+        let seen = MatMut::from_column_major_slice_mut(&mut self.seen, k, 1);
+        matmul(seen, Accum::Replace, psi_t, MatRef::from_column_major_slice(f, n, 1), 1.0, Par::Seq);
+        self.seen.iter().map(|z| z * z).sum()
     }
 
     /// The number of error directions k.

@@ -1,6 +1,7 @@
 //! The estimate of an adaptive run, a holder's kicks in its error model
 //! and the error a return carries ([`crate::physics::run::simulator::estimators`]).
 
+use super::unseen::unseen_share_sq;
 use super::{slot_motion, Adaptive};
 use crate::physics::error::PhysicsError;
 use crate::physics::run::error_model::ErrorState;
@@ -18,6 +19,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// its ‖e‖² and the motion stand for the `wait` communication steps since the last estimate.
     pub(super) fn estimate(&mut self) -> Result<(), PhysicsError> {
         let carried = self.error.e.iter().chain(&self.error.v).chain(&self.error.a).any(|x| *x != 0.0);
+        self.unseen_sq = 0.0;
         let d = self.reduced.space.scene().dim;
         // The motion from the slot positions the estimate has anyway.
         let mut motion = None;
@@ -49,6 +51,10 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
                     model.linearize(self.full.space.scene(), None);
                 } else {
                     let felt = self.reduced.felt_loads();
+                    // Once the estimates are half their longest gap apart (a pass over every spring).
+                    if 2 * self.gap >= self.period {
+                        self.unseen_sq = unseen_share_sq(&mut self.reduced, model, &mut self.residual);
+                    }
                     let space = &self.reduced.space;
                     let scene = space.scene();
                     let point = self.reduced.work.as_ref().point_force_as(&felt.point_load, scene).map(|(dof, f)| {

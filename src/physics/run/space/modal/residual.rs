@@ -35,3 +35,29 @@ impl<F: ReducedForce> Modal<F> {
         }
     }
 }
+
+impl<F: ReducedForce> Modal<F> {
+    /// The full force f = f_springs(x* + Phi q) + M g + f_p at q into `out`
+    /// (free DOFs, every spring), with ||f||^2_{M^-1} and |Phi^T f|^2: since
+    /// Phi^T M Phi = I, the residual r = f - M Phi Phi^T f has
+    /// ||r||^2_{M^-1} = ||f||^2_{M^-1} - |Phi^T f|^2, and a direction psi
+    /// M-orthogonal to the basis sees psi^T r = psi^T f. One pass over every
+    /// spring and faer's n r product.
+    pub fn loaded_force(&self, gravity: &[f64; 3], point: &[f64; 3], q: &[f64], w: &mut ModalWork<F::Work>, out: &mut [f64]) -> (f64, f64) {
+        let d = self.scene.dim;
+        let mass = &self.scene.dof_mass;
+        out.copy_from_slice(self.force.spring_forces(&self.scene, &self.modes, q, &mut w.force));
+        for (k, o) in out.iter_mut().enumerate() {
+            *o += mass[k] * gravity[k % d];
+        }
+        if let Some((dof, f)) = w.loads.point_force_as(point, &self.scene) {
+            for (i, &fi) in f.iter().enumerate() {
+                out[dof + i] += fi;
+            }
+        }
+        let all = out.iter().zip(&self.inv_mass).map(|(f, m)| f * f * m).sum();
+        let projected = &mut w.generalized_scratch;
+        self.modes.project(out, projected);
+        (all, projected.iter().map(|f| f * f).sum())
+    }
+}
