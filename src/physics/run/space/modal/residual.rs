@@ -11,17 +11,9 @@ impl<F: ReducedForce> Modal<F> {
     /// the error model ([`crate::physics::run::error_model`]). One pass over
     /// every spring and 2 n r operations.
     pub fn residual_force(&self, gravity: &[f64; 3], point: &[f64; 3], q: &[f64], w: &mut ModalWork<F::Work>, out: &mut [f64]) {
-        let (d, r) = (self.scene.dim, self.modes.basis.r);
+        let r = self.modes.basis.r;
         let mass = &self.scene.dof_mass;
-        out.copy_from_slice(self.force.spring_forces(&self.scene, &self.modes, q, &mut w.force));
-        for (k, o) in out.iter_mut().enumerate() {
-            *o += mass[k] * gravity[k % d];
-        }
-        if let Some((dof, f)) = w.loads.point_force_as(point, &self.scene) {
-            for (i, &fi) in f.iter().enumerate() {
-                out[dof + i] += fi;
-            }
-        }
+        self.full_force(gravity, point, q, w, out);
         let phi = &self.modes.basis.phi;
         let big_f = &mut w.generalized_scratch;
         big_f.fill(0.0);
@@ -44,6 +36,15 @@ impl<F: ReducedForce> Modal<F> {
     /// M-orthogonal to the basis sees psi^T r = psi^T f. One pass over every
     /// spring and faer's n r product.
     pub fn loaded_force(&self, gravity: &[f64; 3], point: &[f64; 3], q: &[f64], w: &mut ModalWork<F::Work>, out: &mut [f64]) -> (f64, f64) {
+        self.full_force(gravity, point, q, w, out);
+        let all = out.iter().zip(&self.inv_mass).map(|(f, m)| f * f * m).sum();
+        let projected = &mut w.generalized_scratch;
+        self.modes.project(out, projected);
+        (all, projected.iter().map(|f| f * f).sum())
+    }
+
+    /// f = f_springs(x* + Phi q) + M g + f_p into `out` (free DOFs, every spring).
+    fn full_force(&self, gravity: &[f64; 3], point: &[f64; 3], q: &[f64], w: &mut ModalWork<F::Work>, out: &mut [f64]) {
         let d = self.scene.dim;
         let mass = &self.scene.dof_mass;
         out.copy_from_slice(self.force.spring_forces(&self.scene, &self.modes, q, &mut w.force));
@@ -55,9 +56,5 @@ impl<F: ReducedForce> Modal<F> {
                 out[dof + i] += fi;
             }
         }
-        let all = out.iter().zip(&self.inv_mass).map(|(f, m)| f * f * m).sum();
-        let projected = &mut w.generalized_scratch;
-        self.modes.project(out, projected);
-        (all, projected.iter().map(|f| f * f).sum())
     }
 }
