@@ -7,7 +7,7 @@ Chromium, headless (software WebGL: no GPU here), per scene:
 - control -> screen: Pause clicked until the page's button reads Play (the
   round trip through the server to the page's DOM), and a weight typed into
   the page until the page draws a frame of the FMU's having it;
-- frames/s the page draws while paused (its drawing alone).
+- frames/s the page draws while paused (no frames arrive: its drawing alone).
 
     .venv/bin/python python/view_measure.py [FMU] [--scene default --scene cloth-3d-100x100] [--seconds 5] [--screenshots DIR]
 """
@@ -71,7 +71,7 @@ def measure(fmu, scene, seconds, screenshots, fps=60.0):
         button.click()
         clients.until(lambda: driver.find_elements(By.XPATH, "//button[contains(., 'Play')]"), timeout=10)
         row["Pause -> button [ms]"] = 1e3 * (time.perf_counter() - start)
-        # Paused: the server sends the same frame on; what the page draws then is its drawing alone.
+        # Paused: the server sends no frames; what the page draws then is its drawing alone.
         time.sleep(0.5)
         clients.counted(driver)
         time.sleep(seconds)

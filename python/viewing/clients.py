@@ -157,9 +157,22 @@ def mouse_drag(driver, start, pixels):
 
 
 def number_box(driver, label):
-    """The number box of the page's control named `label` (lil-gui)."""
+    """The number box of the page's control named `label` (lil-gui), its folder opened."""
     xpath = f"//div[contains(@class, 'lil-controller')][.//div[@class='lil-name'][contains(., '{label}')]]//input"
-    return driver.find_element("xpath", xpath)
+    box = driver.find_element("xpath", xpath)
+    if driver.execute_script(OPEN_FOLDERS, box):
+        time.sleep(0.5)  # lil-gui's opening transition
+    until(box.is_displayed, timeout=10)
+    return box
+
+
+OPEN_FOLDERS = """
+let opened = false;
+for (let e = arguments[0]; e; e = e.parentElement)
+  if (e.classList.contains("lil-closed")) { e.querySelector(":scope > .lil-title").click(); opened = true; }
+arguments[0].scrollIntoView({ block: "center" });
+return opened;
+"""
 
 
 def type_into(driver, label, text):

@@ -34,6 +34,8 @@ HOLDER_SPEED = 1.0
 HOLDER_TURN = 0.5
 HOLDER_LAG = 0.05
 MODE_SLIDERS = 24
+# The part of a frame's time the stepping may take.
+STEPPING = 0.7
 # How far [m] the page's expansion may be from the FMU's positions (else positions are sent).
 EXPANDS = 1e-6
 # Binary messages: a uint32 kind and a uint32 frame number, then float32 values.
@@ -119,6 +121,9 @@ class Page:
             self.rest = s.start - np.tensordot(q0, self.shapes, 1)
             self.modal = s.reduction == 1 and s.r > 0
             self._send_instance()
+            self.send(self.frame())
+            self.frames_sent += 1
+            self.sent_time = s.time
 
     def _coordinates(self):
         s = self.session
@@ -263,9 +268,14 @@ class Page:
             s.set_load(pull * min(1.0, limit / norm) if norm > 0 else pull)
 
     def _advance(self):
+        """The steps the clock asks for, for at most STEPPING of a frame's time (a run too slow
+        for real time falls behind, and the page still gets its frames)."""
         s = self.session
         due = self.clock.due(s.time) if self.playing else 0
+        end = time.perf_counter() + STEPPING / self.fps
         for _ in range(due):
+            if time.perf_counter() > end:
+                break
             self._follow()
             try:
                 s.step()
@@ -335,8 +345,10 @@ class Page:
                 if self.session is None:
                     break
                 self._advance()
-                self.send(self.frame())
-                self.frames_sent += 1
+                if self.session.time != self.sent_time:  # paused: nothing new to draw
+                    self.send(self.frame())
+                    self.frames_sent += 1
+                    self.sent_time = self.session.time
                 now = time.perf_counter()
                 if now - mark >= 0.5:
                     self.rate = (self.frames_sent - frames0) / (now - mark)
