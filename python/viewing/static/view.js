@@ -17,9 +17,12 @@ const CLASSES = ["in-plane", "out-of-plane", "symmetric", "antisymmetric"];
 const COLOURS = { springs: 0x3c78c8, nodes: 0x14285a, held: 0xdc2828, load: 0xf09614, sheet: 0x5aa0e6, ghost: 0x969696 };
 
 // What tests and measurements read: counts, the positions drawn, helpers.
-const view = (window.view = { received: 0, drawn: 0, frame: -1, positions: null, ghosts: 0 });
+// expanding, drawing: ms spent in this script on new frames, and in all of draw() with three.js's render calls.
+const view = (window.view = { received: 0, drawn: 0, frame: -1, positions: null, ghosts: 0, expanding: 0, drawing: 0 });
 
-const renderer = new THREE.WebGLRenderer({ antialias: true });
+// ?antialias=0: no multisampling (software WebGL draws faster without).
+const query = new URLSearchParams(location.search);
+const renderer = new THREE.WebGLRenderer({ antialias: query.get("antialias") !== "0" });
 renderer.setPixelRatio(window.devicePixelRatio);
 renderer.setSize(window.innerWidth, window.innerHeight);
 document.body.appendChild(renderer.domElement);
@@ -188,6 +191,7 @@ function handle(object, size, moved) {
 }
 
 function draw() {
+  const begin = performance.now();
   if (latest && drawn) {
     expand(latest);
     view.frame = latest.frame;
@@ -198,6 +202,7 @@ function draw() {
     if (!pulling) loadHandle.object.position.fromArray(x, 3 * inst.loadNode);
     view.positions = x;
   }
+  view.expanding += performance.now() - begin;
   for (const k of dirtyHolders) {
     const o = handles[k].object;
     send({ type: "holder", holder: k, position: o.position.toArray(), quaternion: o.quaternion.toArray() });
@@ -205,6 +210,7 @@ function draw() {
   dirtyHolders.clear();
   renderer.render(scene, camera);
   labels.render(scene, camera);
+  view.drawing += performance.now() - begin;
   view.drawn++;
   requestAnimationFrame(draw);
 }
@@ -330,4 +336,5 @@ view.onScreen = (p) => {
   return [((v.x + 1) / 2) * window.innerWidth, ((1 - v.y) / 2) * window.innerHeight];
 };
 view.hovered = (k) => handles[k] && handles[k].axis;
+view.handles = () => [...handles, loadHandle];
 view.pivot = (k) => handles[k].object.position.toArray();
