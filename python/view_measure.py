@@ -9,7 +9,7 @@ Chromium, headless (software WebGL: no GPU here), per scene:
   the page until the page draws a frame of the FMU's having it;
 - frames/s the page draws while paused (no frames arrive: its drawing alone).
 
-    .venv/bin/python python/view_measure.py [FMU] [--scene default --scene cloth-3d-100x100] [--seconds 5] [--screenshots DIR]
+    .venv/bin/python python/view_measure.py [FMU] [--scene default --scene cloth-3d-100x100] [--seconds 5] [--screenshots DIR] [--antialias]
 """
 
 import argparse
@@ -24,14 +24,14 @@ from viewing import clients
 from viewing.page import in_class
 
 
-def measure(fmu, scene, seconds, screenshots, fps=60.0):
+def measure(fmu, scene, seconds, screenshots, fps=60.0, antialias=False):
     from selenium.webdriver.common.by import By
     from selenium.webdriver.common.keys import Keys
 
     viewer = Viewer(fmu, scene, port=clients.free_port(), fps=fps)
     driver = clients.chromium()
     try:
-        driver.get(viewer.url())
+        driver.get(viewer.url() + ("/?antialias=1" if antialias else ""))
         clients.until(lambda: viewer.pages, timeout=120)
         (page,) = viewer.pages.values()
         clients.until(lambda: "frames/s" in driver.find_element(By.TAG_NAME, "body").text, timeout=120)
@@ -89,8 +89,9 @@ def main(argv=None):
     p.add_argument("--seconds", type=float, default=5.0)
     p.add_argument("--screenshots", default=None, help="a directory for a screenshot per scene")
     p.add_argument("--fps", type=float, default=60.0, help="frames a second the server sends (default 60)")
+    p.add_argument("--antialias", action="store_true", help="the page multisampled (?antialias=1)")
     args = p.parse_args(argv)
-    rows = [measure(args.fmu, s, args.seconds, args.screenshots, args.fps) for s in args.scene or ["default", "cloth-3d-100x100"]]
+    rows = [measure(args.fmu, s, args.seconds, args.screenshots, args.fps, args.antialias) for s in args.scene or ["default", "cloth-3d-100x100"]]
     keys = list(rows[0])
     print("| " + " | ".join(keys) + " |")
     print("|" + "---|" * len(keys))

@@ -20,9 +20,9 @@ const COLOURS = { springs: 0x3c78c8, nodes: 0x14285a, held: 0xdc2828, load: 0xf0
 // expanding, drawing: ms spent in this script on new frames, and in all of draw() with three.js's render calls.
 const view = (window.view = { received: 0, drawn: 0, frame: -1, positions: null, ghosts: 0, expanding: 0, drawing: 0 });
 
-// ?antialias=0: no multisampling (software WebGL draws faster without).
+// ?antialias=1: multisampled (smoother lines; software WebGL draws half as fast or less).
 const query = new URLSearchParams(location.search);
-const renderer = new THREE.WebGLRenderer({ antialias: query.get("antialias") !== "0" });
+const renderer = new THREE.WebGLRenderer({ antialias: query.get("antialias") === "1" });
 renderer.setPixelRatio(window.devicePixelRatio);
 renderer.setSize(window.innerWidth, window.innerHeight);
 document.body.appendChild(renderer.domElement);
@@ -143,7 +143,7 @@ function build() {
   const objects = [];
   const big = n > LINE_NODES;
   if (big) {
-    objects.push(new THREE.Mesh(surface(attribute), new THREE.MeshStandardMaterial({ color: COLOURS.sheet, side: THREE.DoubleSide })));
+    objects.push(new THREE.Mesh(surface(attribute), new THREE.MeshLambertMaterial({ color: COLOURS.sheet, side: THREE.DoubleSide })));
   } else {
     const g = new THREE.BufferGeometry();
     g.setAttribute("position", attribute);
@@ -337,4 +337,5 @@ view.onScreen = (p) => {
 };
 view.hovered = (k) => handles[k] && handles[k].axis;
 view.handles = () => [...handles, loadHandle];
+view.scene = scene;
 view.pivot = (k) => handles[k].object.position.toArray();
