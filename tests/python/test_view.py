@@ -301,8 +301,8 @@ def test_the_page_expands_the_modes_as_the_fmu_places_its_nodes(default_fmu, bro
         # The mode gallery: six modes with their frequencies beside the sheet.
         clients.type_into(browser, "from mode", "1")
         clients.until(lambda: browser.execute_script("return view.ghosts") == 6, timeout=10)
-        text = browser.find_element(By.TAG_NAME, "body").text
-        assert all(f"mode {j}: {page.session.frequencies[j - 1]:.2f} Hz" in text for j in range(1, 7))
+        shown = clients.until(lambda: browser.execute_script("return [...document.querySelectorAll('.mode-label')].map(e => e.textContent)"))
+        assert shown == [f"mode {j}: {page.session.frequencies[j - 1]:.2f} Hz" for j in range(1, 7)]
         clients.type_into(browser, "from mode", "0")
         clients.until(lambda: browser.execute_script("return view.ghosts") == 0, timeout=10)
     finally:
@@ -375,3 +375,17 @@ def aim_at_x_arrow(browser):
         if browser.execute_script("return view.hovered(0)") == "X":
             return x0 + dx, y0
     raise AssertionError("no x arrow right of holder 1's handle")
+
+
+def test_the_page_libraries_are_the_pinned_ones():
+    """What the page loads is the pinned version of each package; bytes other than the pinned tarball's are refused."""
+    import json
+
+    from viewing import assets
+
+    root = assets.ensure()
+    for package, (version, _) in assets.PINNED.items():
+        with open(os.path.join(root, package, "package.json")) as f:
+            assert json.load(f)["version"] == version
+        with pytest.raises(ValueError, match="is not the pinned"):
+            assets.checked(package, b"not the tarball")
