@@ -28,7 +28,8 @@ from viewing.protocol import CLASSES, parse
 from viewing.session import STRONGEST_PULL, Clock, Refused, Session
 
 PULL_LENGTH = 0.1
-# Highest speed [m/s], turn rate [rad/s] and time constant [s] of a holder following its handle
+# Highest speed [m/s], turn rate [rad/s] and time constant [s] of a holder following its handle (the turn
+# rate also at most HOLDER_SPEED over the sheet's reach from the pivot)
 # (the FMU refuses a holder whose velocity jumps by more than a step can take).
 HOLDER_SPEED = 1.0
 HOLDER_TURN = 0.5
@@ -113,6 +114,8 @@ class Page:
             self.target = np.zeros((s.n_holders, 6))
             self.pull = None
             self.pivots = [as3(s.start[h[:1]])[0] if len(h) else np.zeros(3) for h in s.holders]
+            # How far the sheet reaches from each pivot: a turn moves its far end at most HOLDER_SPEED.
+            self.reach = [float(np.linalg.norm(as3(s.start) - p, axis=1).max()) or 1.0 for p in self.pivots]
             self.holder_of = np.zeros(s.n, dtype=np.int64)
             for k, nodes in enumerate(s.holders):
                 self.holder_of[np.asarray(nodes, dtype=np.int64)] = k
@@ -255,7 +258,7 @@ class Page:
             reach = np.linalg.norm(step[:3])
             if reach > most:
                 step[:3] *= most / reach
-            turn, most = np.linalg.norm(step[3:]), HOLDER_TURN * s.h
+            turn, most = np.linalg.norm(step[3:]), min(HOLDER_TURN, HOLDER_SPEED / self.reach[k]) * s.h
             if turn > most:
                 step[3:] *= most / turn
             s.set_anchor(k, s.anchors[k][:3] + step[:3], s.anchors[k][3:] + step[3:])
@@ -276,10 +279,14 @@ class Page:
         for _ in range(due):
             if time.perf_counter() > end:
                 break
+            anchors = s.anchors.copy()
             self._follow()
             try:
                 s.step()
             except Refused as e:
+                # The FMU kept its last good state, its holders where they were: so do the session and the handles.
+                s.anchors[:] = anchors
+                self.target[:] = anchors
                 self.playing = False
                 self.refuse(str(e) + " (paused at the last good state)")
                 self.send({"type": "controls", **self._controls()})

@@ -389,3 +389,26 @@ def test_the_page_libraries_are_the_pinned_ones():
             assert json.load(f)["version"] == version
         with pytest.raises(ValueError, match="is not the pinned"):
             assets.checked(package, b"not the tarball")
+
+
+def test_static_correction_expands_and_adaptive_runs_get_positions(fmu, scenes):
+    """Cloth 100 x 100 (16 load modes with static correction), its holder moved and turned: the
+    expansion the page makes (Page.expanded, as view.js) is the FMU's positions; an adaptive run gets positions."""
+    from viewing.page import MODAL, POSITIONS, Page
+
+    adaptive = {**scenes["default"], "reduction": "adaptive"}
+    for name, values, kind in (("cloth-3d-100x100", scenes["cloth-3d-100x100"], MODAL), ("adaptive", adaptive, POSITIONS)):
+        sent = []
+        page = Page(sent.append, fmu, {name: values}, name)
+        try:
+            with page.lock:
+                s = page.session
+                page.target[0] = s.checked_anchor(0, [0.05, 0.02, 0.03 * (s.dim - 2)], [0.02 * (s.dim - 2), 0.0, 0.03])
+            clients.until(lambda: np.allclose(page.status()["anchors"][0], page.target[0], atol=1e-9), timeout=30)  # noqa: B023
+            with page.lock:
+                frames = {int.from_bytes(m[:4], "little") for m in sent if isinstance(m, bytes)} - {0}
+                assert frames == {kind} and page.status()["refusals"] == []
+                if kind == MODAL:
+                    assert page.modal and np.abs(page.expanded(page._coordinates()) - s.positions()).max() < 1e-12
+        finally:
+            page.close()
