@@ -7,15 +7,19 @@ steered from the page, values checked before the FMU sees them.
 - The server with bare protocol clients (what a page sends, and what a
   hostile one might): bound to 127.0.0.1 only; two pages get two instances,
   a page that goes frees its own; a dragged holder handle moves the held
-  nodes; malformed, out-of-range and unknown messages and bytes that are not
-  messages are refused with the reason and leave the run bit for bit as a
-  twin session's, and the instance and the server keep running.
+  nodes, a pulled load handle loads the load node; malformed, out-of-range
+  and unknown messages and bytes that are not messages are refused with the
+  reason and leave the run bit for bit as a twin session's, and the
+  instance and the server keep running.
 - Debian's Chromium, headless: the page loads and draws the sheet, a weight
   typed into the page changes the motion (read back from the FMU), the
   holder dragged with the mouse moves the held nodes, Pause stops the run;
   the positions the page expands from the modal coordinates are the FMU's
   with a holder moved and turned; the mode gallery draws six modes; a
-  screenshot into $MMS_VIEW_SCREENSHOTS when set."""
+  screenshot into $MMS_VIEW_SCREENSHOTS when set.
+- A page's server side alone: cloth 100 x 100 with static correction
+  expands to the FMU's positions, an adaptive run is sent positions; the
+  page's libraries are the pinned ones."""
 
 import math
 import os
@@ -189,6 +193,13 @@ def test_dragging_a_holder_moves_its_nodes(viewer):
         assert np.allclose(moved[:, 0], 0.05, atol=1e-6) and np.allclose(moved[:, 1], 0.02, atol=1e-6)
         force = page.status()["holder_force"]
         assert math.isfinite(force[1]) and force[1] < 0
+        # The load node pulled by its handle 0.1 m below it: a load of one sheet weight down, gone when let go.
+        below = page.status()["load_node"] + np.array([0.0, -0.1])
+        bare.send({"type": "pull", "position": [*below.tolist(), 0.0]})
+        (load,) = clients.until(lambda: np.any(page.session.load != 0.0) and [page.session.load.copy()])
+        assert load[1] < -0.5 * page.session.weight and abs(load[2]) == 0.0
+        bare.send({"type": "pull", "position": None})
+        clients.until(lambda: np.all(page.session.load == 0.0))
     finally:
         bare.close()
 

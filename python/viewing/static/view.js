@@ -267,13 +267,13 @@ function buildControls() {
   const g = gui.addFolder("Gravity and damping");
   const gravity = () => send({ type: "gravity", ...values.gravity });
   values.gravity = { ...inst.gravity };
-  ui.size = g.add(values.gravity, "size", 0, 30, 0.01).name("|g| [m/s²]").onChange(gravity);
-  ui.turn = g.add(values.gravity, "turn", -180, 180, 1).name("turned in plane [°]").onChange(gravity);
-  ui.out = g.add(values.gravity, "out", -90, 90, 1).name("out of plane [°]").onChange(gravity).disable(inst.dim === 2);
+  g.add(values.gravity, "size", 0, 30, 0.01).name("|g| [m/s²]").onChange(gravity);
+  g.add(values.gravity, "turn", -180, 180, 1).name("turned in plane [°]").onChange(gravity);
+  g.add(values.gravity, "out", -90, 90, 1).name("out of plane [°]").onChange(gravity).disable(inst.dim === 2);
   values.damping = { ...inst.damping };
   const damping = () => send({ type: "damping", ...values.damping });
-  ui.alpha = g.add(values.damping, "alpha", 0, 5, 0.01).name("damping α [1/s]").onChange(damping);
-  ui.beta = g.add(values.damping, "beta", 0, 0.01, 0.0001).name("damping β [s]").onChange(damping);
+  g.add(values.damping, "alpha", 0, 5, 0.01).name("damping α [1/s]").onChange(damping);
+  g.add(values.damping, "beta", 0, 0.01, 0.0001).name("damping β [s]").onChange(damping);
   const w = gui.addFolder("Mode weights");
   if (!inst.takesWeights) w.add({ note: "a modal run only" }, "note").name("weights act on").disable();
   values.classes = Object.fromEntries(CLASSES.map((c) => [c, 1]));
@@ -282,10 +282,9 @@ function buildControls() {
       .onChange((value) => send({ type: "classWeight", class: c, value }));
   }
   values.modes = inst.weights.slice(0, inst.modeSliders);
-  ui.modes = [];
   for (let j = 0; j < inst.modeSliders; j++) {
-    ui.modes.push(w.add(values.modes, j, 0, 2, 0.01).name(`mode ${j + 1}: ${inst.frequencies[j].toFixed(2)} Hz`)
-      .onChange((value) => send({ type: "modeWeight", mode: j, value })));
+    w.add(values.modes, j, 0, 2, 0.01).name(`mode ${j + 1}: ${inst.frequencies[j].toFixed(2)} Hz`)
+      .onChange((value) => send({ type: "modeWeight", mode: j, value }));
   }
   if (inst.modeSliders > 6) w.close();
   const gal = gui.addFolder("Mode gallery");
