@@ -112,15 +112,18 @@ class Connection:
         self.loop.call_soon_threadsafe(self.ready.set)
 
     async def pump(self, ws):
-        while not ws.closed:
-            await self.ready.wait()
-            self.ready.clear()
-            while self.outbox:
-                m = self.outbox.popleft()
-                await (ws.send_str(m) if isinstance(m, str) else ws.send_bytes(m))
-            frame, self.latest = self.latest, None
-            if frame is not None:
-                await ws.send_bytes(frame)
+        try:
+            while not ws.closed:
+                await self.ready.wait()
+                self.ready.clear()
+                while self.outbox:
+                    m = self.outbox.popleft()
+                    await (ws.send_str(m) if isinstance(m, str) else ws.send_bytes(m))
+                frame, self.latest = self.latest, None
+                if frame is not None:
+                    await ws.send_bytes(frame)
+        except ConnectionError:
+            pass  # the page went: its handler frees the instance
 
 
 class Viewer:
@@ -167,7 +170,8 @@ class Viewer:
 
         from viewing.page import Page
 
-        ws = web.WebSocketResponse(max_msg_size=1 << 16, heartbeat=None)
+        # Messages up to 4 MiB reach the protocol's check (and its refusal); larger ones end the connection.
+        ws = web.WebSocketResponse(max_msg_size=1 << 22, heartbeat=None)
         await ws.prepare(request)
         self.sockets.add(ws)
         connection = Connection(asyncio.get_running_loop())

@@ -224,6 +224,7 @@ HOSTILE = [
     {"no": "type"},
     [1, 2, 3],
     "not json",
+    '{"type": "reset", "padding": "' + "x" * 100_000 + '"}',
     b"\x00\xffbinary garbage",
 ]
 
