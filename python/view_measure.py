@@ -2,7 +2,9 @@
 Chromium, headless (software WebGL: no GPU here), per scene:
 
 - frames/s the server sends to the page and the real-time factor of its run;
-- messages/s the page receives and frames/s it draws (counted in the page);
+- messages/s the page receives and frames/s it draws (counted in the page),
+  and the time its script spends a frame expanding the modes and in all of
+  its draw() with three.js's calls (the rest of a frame is the browser's);
 - control -> FMU: a weight typed into the page until the FMU has it;
 - control -> screen: Pause clicked until the page's button reads Play (the
   round trip through the server to the page's DOM), and a weight typed into
@@ -37,10 +39,12 @@ def measure(fmu, scene, seconds, screenshots, fps=60.0, antialias=False):
         clients.until(lambda: "frames/s" in driver.find_element(By.TAG_NAME, "body").text, timeout=120)
         time.sleep(2.0)
         clients.counted(driver)
-        f0, t0, w0 = page.frames_sent, page.status()["time"], time.perf_counter()
+        script = "return [view.drawn, view.expanding, view.drawing]"
+        f0, t0, w0, s0 = page.frames_sent, page.status()["time"], time.perf_counter(), driver.execute_script(script)
         time.sleep(seconds)
         received, drawn = clients.counted(driver)
-        wall = time.perf_counter() - w0
+        wall, s1 = time.perf_counter() - w0, driver.execute_script(script)
+        frames = max(s1[0] - s0[0], 1)
         row = {
             "scene": scene,
             "nodes": page.session.n,
@@ -48,6 +52,8 @@ def measure(fmu, scene, seconds, screenshots, fps=60.0, antialias=False):
             "real-time factor": (page.status()["time"] - t0) / wall,
             "received/s": len(received) / wall,
             "drawn/s": len(drawn) / wall,
+            "expanding [ms/frame]": (s1[1] - s0[1]) / frames,
+            "draw() [ms/frame]": (s1[2] - s0[2]) / frames,
         }
         if screenshots:
             os.makedirs(screenshots, exist_ok=True)

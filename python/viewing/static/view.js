@@ -335,6 +335,4 @@ view.onScreen = (p) => {
   return [((v.x + 1) / 2) * window.innerWidth, ((1 - v.y) / 2) * window.innerHeight];
 };
 view.hovered = (k) => handles[k] && handles[k].axis;
-view.handles = () => [...handles, loadHandle];
-view.scene = scene;
 view.pivot = (k) => handles[k].object.position.toArray();
