@@ -289,7 +289,7 @@ class Page:
                 self.target[:] = anchors
                 self.playing = False
                 self.refuse(str(e) + " (paused at the last good state)")
-                self.send({"type": "controls", **self._controls()})
+                self.send({"type": "controls", **self._controls(), "anchors": s.anchors.tolist()})  # the handles back too
                 break
 
     def placements(self):

@@ -302,6 +302,12 @@ function showControls(m) {
   Object.assign(values.damping, m.damping);
   for (let j = 0; j < values.modes.length; j++) values.modes[j] = m.weights[j];
   for (const c of gui.controllersRecursive()) c.updateDisplay();
+  // After a refused step: each holder's handle where the FMU kept the holder (pivot + translation, turned by the rotation vector).
+  if (m.anchors) m.anchors.forEach((a, k) => {
+    const o = handles[k].object, turn = new THREE.Vector3(a[3], a[4], a[5]), angle = turn.length();
+    o.position.fromArray(inst.pivots[k]).add(new THREE.Vector3(a[0], a[1], a[2]));
+    o.quaternion.setFromAxisAngle(angle > 0 ? turn.divideScalar(angle) : turn.set(1, 0, 0), angle);
+  });
 }
 
 function showReadouts() {
