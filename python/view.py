@@ -1,6 +1,8 @@
-"""The sheet live in a browser: a local server (viser, bound to 127.0.0.1
+"""The sheet live in a browser: a local server (aiohttp, bound to 127.0.0.1
 only) that loads the FMU with fmpy, runs one instance per page in real time
-and draws it in 3D (2D scenes flat), with its controls beside it.
+and sends it the modal coordinates each frame; the page (three.js,
+viewing/static/) expands them with the mode shapes and draws the sheet in 3D
+(2D scenes flat), with its controls beside it.
 
     .venv/bin/python python/view.py [FMU] [--scene NAME] [--set NAME=VALUE ...] [--port 8080] [--no-open]
     cargo xtask view -- --scene cloth-3d
@@ -15,12 +17,15 @@ modal basis of load modes holds the holders' motion.
 
 Each page gets its own FMU instance (freed when the page closes); a value a
 page sends is checked before the FMU sees it and a refused one is shown on
-the page with the reason, the instance keeping its last good state; bytes that are not a
-message of viser's protocol are refused (viewing/protocol.py) and the page
+the page with the reason, the instance keeping its last good state; a message that is not one of
+the protocol's (viewing/protocol.py) is refused with the reason and the page
 goes on.
 """
 
 import argparse
+import asyncio
+import collections
+import json
 import os
 import sys
 import threading
@@ -83,47 +88,128 @@ def overrides_of(fmu, sets):
     return out
 
 
+STATIC = os.path.join(ROOT, "python", "viewing", "static")
+# Binary frames of these kinds only the newest counts (a slow page skips frames, never lags).
+FRAMES = (1, 2)
+
+
+class Connection:
+    """One page's websocket: what its Page sends queued (control messages in
+    order, of the frames only the newest) and sent from the server's loop."""
+
+    def __init__(self, loop):
+        self.loop, self.outbox, self.latest = loop, collections.deque(), None
+        self.ready = asyncio.Event()
+
+    def push(self, message):
+        """Thread-safe: a dict (JSON) or bytes (binary) for the page."""
+        if isinstance(message, bytes) and int.from_bytes(message[:4], "little") in FRAMES:
+            self.latest = message
+        else:
+            if isinstance(message, dict) and message.get("type") == "instance":
+                self.latest = None  # a frame of the instance before
+            self.outbox.append(json.dumps(message) if isinstance(message, dict) else message)
+        self.loop.call_soon_threadsafe(self.ready.set)
+
+    async def pump(self, ws):
+        try:
+            while not ws.closed:
+                await self.ready.wait()
+                self.ready.clear()
+                while self.outbox:
+                    m = self.outbox.popleft()
+                    await (ws.send_str(m) if isinstance(m, str) else ws.send_bytes(m))
+                frame, self.latest = self.latest, None
+                if frame is not None:
+                    await ws.send_bytes(frame)
+        except ConnectionError:
+            pass  # the page went: its handler frees the instance
+
+
 class Viewer:
-    """The server and its pages (one per connected client)."""
+    """The server (aiohttp on 127.0.0.1: the page, its libraries, a websocket per page) and its pages."""
 
     def __init__(self, fmu_path, scene_name="default", sets=(), port=8080, fps=60.0):
-        import viser
+        from aiohttp import web
 
-        from viewing import protocol
-        from viewing.page import Page
+        from viewing import assets
 
-        protocol.guard()
-
+        self.assets = assets.ensure()
         self.fmu = Fmu(fmu_path)
         self.scenes = scene_table(self.fmu, overrides_of(self.fmu, sets))
         if scene_name not in self.scenes:
             raise ValueError(f"--scene {scene_name}: one of {', '.join(self.scenes)}")
-        self.pages, self.lock = {}, threading.Lock()
-        self.server = viser.ViserServer(host="127.0.0.1", port=port, label="Modal mass-spring sheet", verbose=False)
-        self.port = self.server.get_port()
+        self.scene_name, self.fps = scene_name, fps
+        self.pages, self.sockets, self.lock, self.count = {}, set(), threading.Lock(), 0
+        app = web.Application()
+        async def index(_):
+            return web.FileResponse(os.path.join(STATIC, "index.html"))
 
-        @self.server.on_client_connect
-        def _(client):
-            page = Page(client, self.fmu, self.scenes, scene_name, fps=fps)
-            with self.lock:
-                self.pages[client.client_id] = page
+        app.router.add_get("/", index)
+        app.router.add_get("/ws", self._page)
+        app.router.add_static("/static/", STATIC)
+        app.router.add_static("/three/", os.path.join(self.assets, "three"))
+        app.router.add_static("/lil-gui/", os.path.join(self.assets, "lil-gui"))
+        self.loop = asyncio.new_event_loop()
+        self.runner = web.AppRunner(app, access_log=None)
+        self.loop.run_until_complete(self.runner.setup())
+        for self.port in range(port, port + 20):
+            site = web.TCPSite(self.runner, "127.0.0.1", self.port)
+            try:
+                self.loop.run_until_complete(site.start())
+                break
+            except OSError:
+                continue
+        else:
+            raise OSError(f"no free port in {port}..{port + 19} on 127.0.0.1")
+        self.thread = threading.Thread(target=self.loop.run_forever, name="view-server", daemon=True)
+        self.thread.start()
 
-        @self.server.on_client_disconnect
-        def _(client):
+    async def _page(self, request):
+        from aiohttp import WSMsgType, web
+
+        from viewing.page import Page
+
+        # Messages up to 4 MiB reach the protocol's check (and its refusal); larger ones end the connection.
+        ws = web.WebSocketResponse(max_msg_size=1 << 22, heartbeat=None)
+        await ws.prepare(request)
+        self.sockets.add(ws)
+        connection = Connection(asyncio.get_running_loop())
+        with self.lock:
+            self.count += 1
+            label = f"page {self.count}"
+        page = await asyncio.to_thread(Page, connection.push, self.fmu, self.scenes, self.scene_name, self.fps, label)
+        with self.lock:
+            self.pages[label] = page
+        pump = asyncio.create_task(connection.pump(ws))
+        try:
+            async for message in ws:
+                if message.type in (WSMsgType.TEXT, WSMsgType.BINARY):
+                    await asyncio.to_thread(page.receive, message.data)
+        finally:
+            pump.cancel()
+            self.sockets.discard(ws)
             with self.lock:
-                page = self.pages.pop(client.client_id, None)
-            if page is not None:
-                page.close()
+                self.pages.pop(label, None)
+            await asyncio.to_thread(page.close)
+        return ws
 
     def url(self):
         return f"http://127.0.0.1:{self.port}"
 
     def close(self):
+        async def stop():
+            for ws in list(self.sockets):
+                await ws.close()
+            await self.runner.cleanup()
+
+        asyncio.run_coroutine_threadsafe(stop(), self.loop).result(timeout=20)
         with self.lock:
             pages, self.pages = list(self.pages.values()), {}
         for page in pages:
             page.close()
-        self.server.stop()
+        self.loop.call_soon_threadsafe(self.loop.stop)
+        self.thread.join(timeout=5)
         self.fmu.close()
 
 

@@ -1,22 +1,18 @@
 """Clients of the view's server for the tests and the measurements: Debian's
 Chromium driven headless through selenium (chromium-driver), and a bare
-websocket client that speaks viser's protocol the way its page does (so a
-test can send what a page sends, and what a hostile page might).
+websocket client that speaks the page's protocol (viewing/protocol.py) the
+way the page does (so a test can send what a page sends, and what a hostile
+page might)."""
 
-viser's wire format: a page sends each message as msgpack of its fields
-plus "type"; the server sends windows of messages as
-[8-byte size][8-byte compressed size][zstd msgpack {"messages": [...]}][binary buffers]."""
-
+import asyncio
+import json
 import shutil
 import socket
+import threading
 import time
 
-import msgspec
+import aiohttp
 import numpy as np
-import viser
-import zstandard
-from viser import _messages as messages
-from websockets.sync.client import connect
 
 CHROMIUM = ("/usr/bin/chromium", "/usr/bin/chromium-browser")
 DRIVER = ("/usr/bin/chromedriver", "/usr/lib/chromium/chromedriver")
@@ -71,20 +67,18 @@ def chromium(width=1280, height=800):
     return driver
 
 
-# Counts, in the page, every message its websockets and workers hand it and
-# every frame it draws (performance.now() in ms), from before viser's client loads.
+# Counts, in the page, every message its websocket hands it and every frame
+# it draws (performance.now() in ms), from before the page's script loads.
 COUNTERS = """
 window.__received = []; window.__drawn = [];
-for (const name of ["WebSocket", "Worker"]) {
-  const Open = window[name];
-  window[name] = function (...args) {
-    const opened = new Open(...args);
-    opened.addEventListener("message", () => window.__received.push(performance.now()));
-    return opened;
-  };
-  window[name].prototype = Open.prototype;
-  Object.assign(window[name], Open);
-}
+const Open = window.WebSocket;
+window.WebSocket = function (...args) {
+  const opened = new Open(...args);
+  opened.addEventListener("message", () => window.__received.push(performance.now()));
+  return opened;
+};
+window.WebSocket.prototype = Open.prototype;
+Object.assign(window.WebSocket, Open);
 const draw = () => { window.__drawn.push(performance.now()); requestAnimationFrame(draw); };
 requestAnimationFrame(draw);
 """
@@ -101,88 +95,52 @@ def counted(driver):
     return [np.asarray(t) / 1000.0 for t in got]
 
 
-def encode(message):
-    return msgspec.msgpack.encode(message.as_serializable_dict())
-
-
-def packed(fields):
-    """Any dict as a page would pack a message (msgpack), whether or not viser knows it."""
-    return msgspec.msgpack.encode(fields)
-
-
-def decode(raw):
-    size, packed = int.from_bytes(raw[:8], "little"), int.from_bytes(raw[8:16], "little")
-    inner = zstandard.ZstdDecompressor().decompress(raw[16 : 16 + packed], max_output_size=size)
-    return msgspec.msgpack.decode(inner)["messages"]
-
-
 class Bare:
-    """A page without a browser: connects, says where its camera is (which
-    makes it a client to the server) and reads what the server sends."""
+    """A page without a browser: a websocket to the server (aiohttp's client on
+    a loop of its own) that sends what a page sends, or anything else, and keeps
+    what the server sends: JSON messages in `seen`, binary ones in `binary`."""
 
     def __init__(self, url):
-        self.ws = connect(url.replace("http", "ws"), subprotocols=["viser-v" + viser.__version__], max_size=None)
-        self.seen = []
-        self.send(
-            messages.ViewerCameraMessage(
-                wxyz=(1.0, 0.0, 0.0, 0.0),
-                position=(0.0, 0.0, 1.0),
-                fov=1.0,
-                near=0.01,
-                far=100.0,
-                image_height=600,
-                image_width=800,
-                look_at=(0.0, 0.0, 0.0),
-                up_direction=(0.0, 1.0, 0.0),
-            )
-        )
+        self.loop = asyncio.new_event_loop()
+        self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
+        self.thread.start()
+        self.seen, self.binary = [], []
+        self.ws = self._run(self._connect(url.replace("http", "ws") + "/ws"))
+        self.reader = asyncio.run_coroutine_threadsafe(self._read(), self.loop)
+
+    def _run(self, coroutine, timeout=30):
+        return asyncio.run_coroutine_threadsafe(coroutine, self.loop).result(timeout)
+
+    async def _connect(self, url):
+        self.client = aiohttp.ClientSession()
+        return await self.client.ws_connect(url, max_msg_size=0)
+
+    async def _read(self):
+        async for m in self.ws:
+            if m.type == aiohttp.WSMsgType.TEXT:
+                self.seen.append(json.loads(m.data))
+            elif m.type == aiohttp.WSMsgType.BINARY:
+                self.binary.append(m.data)
+                del self.binary[:-50]
 
     def send(self, message):
-        self.ws.send(encode(message) if not isinstance(message, bytes) else message)
+        """A str or bytes as they are, anything else as JSON."""
+        if not isinstance(message, (str, bytes)):
+            message = json.dumps(message)
+        self._run(self.ws.send_str(message) if isinstance(message, str) else self.ws.send_bytes(message))
 
-    def read(self, seconds):
-        """Every message the server sent in `seconds` (dicts with their "type")."""
-        end = time.time() + seconds
-        while time.time() < end:
-            try:
-                raw = self.ws.recv(timeout=max(0.01, end - time.time()))
-            except TimeoutError:
-                break
-            self.seen += decode(raw)
-        return self.seen
-
-    def find(self, kind, **fields):
-        """The first message of `kind` seen whose fields (or label) match."""
-        for m in self.seen:
-            if m.get("type") == kind and all(m.get(k) == v or m.get("props", {}).get(k) == v for k, v in fields.items()):
-                return m
-        return None
+    def find(self, kind):
+        """The last message of `kind` seen."""
+        return next((m for m in reversed(self.seen) if m.get("type") == kind), None)
 
     def close(self):
-        self.ws.close()
+        async def close():
+            await self.ws.close()
+            await self.client.close()
 
-
-def gui_update(uuid, value):
-    return messages.GuiUpdateMessage(uuid=uuid, updates={"value": value})
-
-
-def drag(name, owner, position, wxyz=(1.0, 0.0, 0.0, 0.0)):
-    return messages.TransformControlsUpdateMessage(name=name, wxyz=tuple(wxyz), position=tuple(float(x) for x in np.asarray(position)), owner=owner)
-
-
-def on_screen(camera, point):
-    """Where the page draws world `point` (pixels from the canvas's top left), from
-    the camera the page reported (viser's CameraHandle: position, look_at, up, vertical fov)."""
-    pos, up = np.asarray(camera.position, dtype=float), np.asarray(camera.up_direction, dtype=float)
-    forward = np.asarray(camera.look_at, dtype=float) - pos
-    forward /= np.linalg.norm(forward)
-    right = np.cross(forward, up)
-    right /= np.linalg.norm(right)
-    up = np.cross(right, forward)
-    d = np.asarray(point, dtype=float) - pos
-    x, y, z = d @ right, d @ up, d @ forward
-    w, h, t = camera.image_width, camera.image_height, np.tan(camera.fov / 2)
-    return (x / (z * t * w / h) + 1) / 2 * w, (1 - y / (z * t)) / 2 * h
+        self._run(close())
+        self.loop.call_soon_threadsafe(self.loop.stop)
+        self.thread.join(5)
 
 
 def mouse_drag(driver, start, pixels):
@@ -196,3 +154,31 @@ def mouse_drag(driver, start, pixels):
     for _ in range(4):
         chain.move_by_offset(int(pixels[0] / 4), int(pixels[1] / 4))
     chain.release().perform()
+
+
+def number_box(driver, label):
+    """The number box of the page's control named `label` (lil-gui), its folder opened."""
+    xpath = f"//div[contains(@class, 'lil-controller')][.//div[@class='lil-name'][contains(., '{label}')]]//input"
+    box = driver.find_element("xpath", xpath)
+    if driver.execute_script(OPEN_FOLDERS, box):
+        time.sleep(0.5)  # lil-gui's opening transition
+    until(box.is_displayed, timeout=10)
+    return box
+
+
+OPEN_FOLDERS = """
+let opened = false;
+for (let e = arguments[0]; e; e = e.parentElement)
+  if (e.classList.contains("lil-closed")) { e.querySelector(":scope > .lil-title").click(); opened = true; }
+arguments[0].scrollIntoView({ block: "center" });
+return opened;
+"""
+
+
+def type_into(driver, label, text):
+    """Types `text` over the number in the box of the control named `label` (each key sets it)."""
+    from selenium.webdriver.common.keys import Keys
+
+    box = number_box(driver, label)
+    box.send_keys(Keys.CONTROL, "a")
+    box.send_keys(text, Keys.ENTER)

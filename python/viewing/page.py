@@ -1,40 +1,51 @@
-"""What one browser page sees and steers: its own FMU instance (a
-Session), the sheet drawn with viser's scene nodes and its controls in
-viser's GUI panel, and a thread that steps the instance in real time and
-sends a frame at the page's frame rate.
+"""What one browser page sees and steers: its own FMU instance (a Session),
+a thread that steps it in real time, and what goes to the page.
 
-Drawn: the springs as line segments and every node as a point (sheets up to
-LINE_NODES nodes), larger sheets as a surface through the nodes; the held
-nodes in red with a handle per holder (drag it to move the holder: its
-anchor inputs), the load node in orange with a handle (drag it to pull the
-node: the load inputs, a spring of one sheet weight per PULL_LENGTH).
-Readouts: simulated time, real-time factor, frames per second, kinetic and
-potential energy, each holder's force, forceResidual, trainingRange,
-errorEstimate, reducedFraction; the FMU's warnings and every refused value
-below them."""
+To the page (viewing/static/view.js draws it): once per instance a JSON
+"instance" message (grid, springs, holders, the load node, the modes'
+frequencies and classes, the controls' values) and one binary message of
+the rest shape x* and the modeShapes Phi (float32); then each frame a small
+binary message. For a modal run that is q (modalCoordinates) and each
+holder's placement (R, t): the page draws node i at R_h (x*_i + Phi_i q) + t_h,
+h its holder (holder 1 for a free node), the `positions` the FMU reports
+(Phi is 0 on held nodes; the sheet is integrated in holder 1's frame,
+src/physics/run/simulator/outputs.rs). A run that does not expand so (full
+space, adaptive, or a modal run whose expansion is found off the FMU's
+positions by more than EXPANDS m) gets its positions each frame instead.
+Readouts, the FMU's warnings and every refusal go as JSON twice a second.
 
+From the page: the JSON control messages of viewing/protocol.py."""
+
+import math
+import struct
+import sys
 import threading
 import time
 
 import numpy as np
 
+from viewing.protocol import CLASSES, parse
 from viewing.session import STRONGEST_PULL, Clock, Refused, Session
 
-LINE_NODES = 2500
 PULL_LENGTH = 0.1
-# Highest speed [m/s] and time constant [s] of a holder following its handle
+# Highest speed [m/s], turn rate [rad/s] and time constant [s] of a holder following its handle (the turn
+# rate also at most HOLDER_SPEED over the sheet's reach from the pivot)
 # (the FMU refuses a holder whose velocity jumps by more than a step can take).
 HOLDER_SPEED = 1.0
+HOLDER_TURN = 0.5
 HOLDER_LAG = 0.05
 MODE_SLIDERS = 24
-# Modes the gallery shows at once.
-GALLERY = 6
-CLASSES = ("in-plane", "out-of-plane", "symmetric", "antisymmetric")
+# The part of a frame's time the stepping may take.
+STEPPING = 0.7
+# How far [m] the page's expansion may be from the FMU's positions (else positions are sent).
+EXPANDS = 1e-6
+# Binary messages: a uint32 kind and a uint32 frame number, then float32 values.
+SHAPES, MODAL, POSITIONS = 0, 1, 2
 
 
-def rotation_vector(wxyz):
-    """The rotation vector (axis times angle) of a unit quaternion (w, x, y, z)."""
-    w, v = float(wxyz[0]), np.asarray(wxyz[1:], dtype=float)
+def rotation_vector(xyzw):
+    """The rotation vector (axis times angle) of a unit quaternion (x, y, z, w)."""
+    v, w = np.asarray(xyzw[:3], dtype=float), float(xyzw[3])
     s = np.linalg.norm(v)
     if s < 1e-12:
         return np.zeros(3)
@@ -42,6 +53,16 @@ def rotation_vector(wxyz):
     if angle > np.pi:
         angle -= 2.0 * np.pi
     return v / s * angle
+
+
+def rotation(theta):
+    """The rotation matrix of a rotation vector (Rodrigues), as the FMU's frame.rs makes it."""
+    angle = float(np.linalg.norm(theta))
+    if angle == 0.0:
+        return np.eye(3)
+    k = np.asarray(theta, dtype=float) / angle
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * (K @ K)
 
 
 def in_class(session, name):
@@ -54,258 +75,176 @@ def in_class(session, name):
     }[name]
 
 
-def grid_faces(nx, ny):
-    """Two triangles per grid cell (node i = row * nx + col)."""
-    r, c = np.meshgrid(np.arange(ny - 1), np.arange(nx - 1), indexing="ij")
-    a = (r * nx + c).ravel()
-    return np.concatenate([np.stack([a, a + 1, a + nx], 1), np.stack([a + 1, a + nx + 1, a + nx], 1)]).astype(np.uint32)
-
-
 def as3(x):
-    """Positions as (nodes, 3) float32 (z = 0 in 2D)."""
-    out = np.zeros((len(x), 3), dtype=np.float32)
+    """Positions as (nodes, 3) (z = 0 in 2D)."""
+    out = np.zeros((len(x), 3))
     out[:, : x.shape[1]] = x
     return out
 
 
 class Page:
-    """One page: its session, scene nodes, controls and stepping thread."""
+    """One page: its session, its stepping thread and what it sends (`send(bytes | dict)`, thread-safe)."""
 
-    def __init__(self, client, fmu, scenes, scene_name, fps=60.0):
-        self.client, self.fmu, self.scenes, self.fps = client, fmu, scenes, fps
+    def __init__(self, send, fmu, scenes, scene_name, fps=60.0, label="page"):
+        self.send, self.fmu, self.scenes, self.fps, self.label = send, fmu, scenes, fps, label
         self.lock = threading.RLock()
         self.playing, self.stopped = True, False
         self.refusals = []
         self.frames_sent, self.rate, self.rtf = 0, 0.0, 0.0
         self.session = None
-        self.gui_nodes = []
-        self._build_run_panel(scene_name)
         self.start(scene_name)
-        self.thread = threading.Thread(target=self._loop, name=f"page-{client.client_id}", daemon=True)
+        self.thread = threading.Thread(target=self._loop, name=label, daemon=True)
         self.thread.start()
 
     # ---- set-up -------------------------------------------------------
 
     def start(self, scene_name):
-        """A new instance of `scene_name` (a structural change makes a new instance)."""
+        """A new instance of the scene (the old one freed)."""
         with self.lock:
-            old, self.session = self.session, None
-            if old is not None:
-                old.close()
-            self.scene_name = scene_name
-            values = self.scenes[scene_name]
-            self.session = Session(self.fmu, values, label=f"page {self.client.client_id}")
-            self.clock = Clock(self.session.h)
-            s = self.session
-            self.target = s.anchors.copy()
-            self.dragging_load = False
-            self._build_scene()
-            self._build_controls()
-            self._note(f"scene {scene_name}: {s.nx} x {s.ny} nodes, {s.dim}D, {s.r} modes, {len(s.springs)} springs")
+            try:
+                fresh = Session(self.fmu, self.scenes[scene_name], label=self.label)
+            except Refused as e:
+                self.refuse(f"scene {scene_name}: {e}")
+                return
+            if self.session is not None:
+                self.session.close()
+            self.session, self.scene_name = fresh, scene_name
+            s = fresh
+            self.clock = Clock(s.h)
+            self.target = np.zeros((s.n_holders, 6))
+            self.pull = None
+            self.pivots = [as3(s.start[h[:1]])[0] if len(h) else np.zeros(3) for h in s.holders]
+            # How far the sheet reaches from each pivot: a turn moves its far end at most HOLDER_SPEED.
+            self.reach = [float(np.linalg.norm(as3(s.start) - p, axis=1).max()) or 1.0 for p in self.pivots]
+            self.holder_of = np.zeros(s.n, dtype=np.int64)
+            for k, nodes in enumerate(s.holders):
+                self.holder_of[np.asarray(nodes, dtype=np.int64)] = k
+            self.shapes = s.mode_shapes() if s.r else np.zeros((0, s.n, s.dim))
+            q0 = self._coordinates()
+            self.rest = s.start - np.tensordot(q0, self.shapes, 1)
+            self.modal = s.reduction == 1 and s.r > 0
+            self._send_instance()
+            self.send(self.frame())
+            self.frames_sent += 1
+            self.sent_time = s.time
 
-    def _build_run_panel(self, scene_name):
-        gui = self.client.gui
-        with gui.add_folder("Run"):
-            self.play = gui.add_button("Pause")
-            self.play.on_click(lambda _: self.toggle())
-            reset = gui.add_button("Reset")
-            reset.on_click(lambda _: self.start(self.scene_name))
-            self.picker = gui.add_dropdown("Scene", tuple(self.scenes), initial_value=scene_name)
-            self.picker.on_update(lambda _: self._pick(self.picker.value))
-            self.readout = gui.add_markdown("starting")
-            self.log = gui.add_markdown("")
+    def _coordinates(self):
+        s = self.session
+        return np.atleast_1d(np.asarray(self.fmu.get(s.inst, "modalCoordinates", s.r), dtype=float)) if s.r else np.zeros(0)
 
-    def _pick(self, name):
-        if name not in self.scenes:
-            self.refuse(f"scene {name!r}: not one of {', '.join(self.scenes)}")
-            return
-        self.start(name)
+    def _send_instance(self):
+        s = self.session
+        members = {c: int(np.count_nonzero(in_class(s, c))) for c in CLASSES}
+        self.send(
+            {
+                "type": "instance",
+                "scene": self.scene_name,
+                "scenes": list(self.scenes),
+                "nx": s.nx, "ny": s.ny, "dim": s.dim, "nodes": s.n, "modes": s.r,
+                "modal": self.modal,
+                "springs": s.springs.tolist(),
+                "holders": [[int(i) for i in h] for h in s.holders],
+                "holderOf": self.holder_of.tolist(),
+                "loadNode": int(s.load_node),
+                "pivots": [p.tolist() for p in self.pivots],
+                "frequencies": s.frequencies.tolist(),
+                "classes": members,
+                "takesWeights": s.reduction == 1,
+                "modeSliders": min(s.r, MODE_SLIDERS) if s.reduction == 1 else 0,
+                "pullLength": PULL_LENGTH,
+                **self._controls(),
+            }
+        )
+        self.send(self._binary(SHAPES, np.concatenate([as3(self.rest).ravel(), np.stack([as3(p) for p in self.shapes]).ravel() if s.r else []])))
 
-    def _build_scene(self):
-        s, scene = self.session, self.client.scene
-        # (no set_up_direction: it also turns the world about the up axis; the camera says where up is)
-        x = as3(s.start)
-        self.big = s.n > LINE_NODES
-        if self.big:
-            self.faces = grid_faces(s.nx, s.ny)
-            self.sheet = scene.add_mesh_simple("/sheet", x, self.faces, color=(90, 160, 230), side="double", flat_shading=False)
-            self.nodes = None
-        else:
-            self.sheet = scene.add_line_segments("/sheet", x[s.springs], (60, 120, 200), thickness=0.004)
-            self.nodes = scene.add_point_cloud("/nodes", x, (20, 40, 90), point_size=0.012, point_shape="circle", precision="float32")
-        size = 0.02 if not self.big else 0.01
-        held = np.concatenate([np.asarray(h, dtype=int) for h in s.holders]) if s.holders else np.zeros(0, int)
-        self.held = held
-        self.held_points = scene.add_point_cloud("/held", x[held], (220, 40, 40), point_size=2 * size, point_shape="circle")
-        self.load_point = scene.add_point_cloud("/load", x[[s.load_node]], (240, 150, 20), point_size=2.5 * size, point_shape="circle")
-        extent = float(np.ptp(x, axis=0).max()) or 1.0
-        self.pivots = [x[np.asarray(h, dtype=int)].mean(axis=0) if len(h) else np.zeros(3) for h in s.holders]
-        self.handles = []
-        for k, pivot in enumerate(self.pivots):
-            handle = scene.add_transform_controls(f"/holder{k + 1}", scale=0.15 * extent, position=pivot, disable_rotations=s.dim == 2)
-            handle.on_update(lambda h, k=k: self._drag_holder(k, h.target))
-            self.handles.append(handle)
-        self.load_handle = scene.add_transform_controls("/pull", scale=0.08 * extent, position=x[s.load_node], disable_rotations=True)
-        self.load_handle.on_update(lambda e: self._set_dragging(e.phase != "end"))
-        self.extent = extent
-        for node in getattr(self, "ghosts", []):
-            node.remove()
-        self.ghosts, self.shapes = [], None
-        # The camera on the sheet: square on for a 2D sheet, from the front and above one side for 3D.
-        center = x.mean(axis=0)
-        view = np.array([0.0, 0.0, 2.2]) if s.dim == 2 else np.array([1.1, 0.5, 1.6])
-        # (viser moves look_at with position: position first.)
-        self.client.camera.position = center + extent * view
-        self.client.camera.look_at = center
-        self.client.camera.up_direction = (0.0, 1.0, 0.0)
+    def _controls(self):
+        """The controls as the session has them (after a change or a refusal)."""
+        s = self.session
+        g = s.gravity
+        size = float(np.linalg.norm(g))
+        turn = math.degrees(math.atan2(g[0], -g[1])) if size else 0.0
+        out = math.degrees(math.asin(max(-1.0, min(1.0, g[2] / size)))) if size else 0.0
+        return {
+            "gravity": {"size": size, "turn": turn, "out": out},
+            "damping": {"alpha": float(s.damping[0]), "beta": float(s.damping[1])},
+            "weights": s.weights.tolist(),
+            "playing": self.playing,
+        }
 
-    def _build_controls(self):
-        for node in self.gui_nodes:
-            node.remove()
-        self.gui_nodes = []
-        s, gui = self.session, self.client.gui
-        g = float(np.linalg.norm(s.gravity))
-        with gui.add_folder("Gravity and damping") as folder:
-            self.gui_nodes.append(folder)
-            self.g_size = gui.add_slider("|g| [m/s²]", 0.0, 30.0, 0.01, round(g, 2))
-            self.g_good = (round(g, 2), 0.0, 0.0)
-            self.g_turn = gui.add_slider("turned in plane [°]", -180.0, 180.0, 1.0, 0.0)
-            self.g_out = gui.add_slider("out of plane [°]", -90.0, 90.0, 1.0, 0.0, disabled=s.dim == 2)
-            for c in (self.g_size, self.g_turn, self.g_out):
-                c.on_update(lambda _: self._gravity())
-            self.alpha = gui.add_slider("damping α [1/s]", 0.0, 5.0, 0.01, float(s.damping[0]))
-            self.beta = gui.add_slider("damping β [s]", 0.0, 0.01, 0.0001, float(s.damping[1]))
-            for c in (self.alpha, self.beta):
-                c.on_update(lambda _: self._damping())
-        with gui.add_folder("Mode weights") as folder:
-            self.gui_nodes.append(folder)
-            modal = s.reduction == 1
-            if not modal:
-                gui.add_markdown("Mode weights act on a modal run only (reduction = modal).")
-            self.class_sliders = {}
-            for name in CLASSES:
-                members = int(np.count_nonzero(in_class(s, name)))
-                slider = gui.add_slider(f"{name} ({members})", 0.0, 2.0, 0.01, 1.0, disabled=not modal or members == 0)
-                slider.on_update(lambda _, name=name: self._class_weight(name))
-                self.class_sliders[name] = slider
-            self.mode_sliders = []
-            for j in range(min(s.r, MODE_SLIDERS) if modal else 0):
-                slider = gui.add_slider(f"mode {j + 1}: {s.frequencies[j]:.2f} Hz", 0.0, 2.0, 0.01, float(s.weights[j]))
-                slider.on_update(lambda _, j=j: self._mode_weight(j))
-                self.mode_sliders.append(slider)
-        with gui.add_folder("Mode gallery") as folder:
-            self.gui_nodes.append(folder)
-            self.gallery = gui.add_slider(f"from mode (0: none; {GALLERY} shown)", 0, s.r, 1, 0)
-            self.gallery.on_update(lambda _: self._guarded(lambda: self._show_modes(int(self.gallery.value))))
+    def _binary(self, kind, values):
+        return struct.pack("<II", kind, self.frames_sent) + np.asarray(values, dtype="<f4").tobytes()
 
     # ---- controls -----------------------------------------------------
 
     def refuse(self, why):
         self.refusals.append(why)
         del self.refusals[:-5]
-        self.client.add_notification("Refused", why, auto_close_seconds=5.0, color="red")
+        print(f"view: {self.label}: refused: {why}", file=sys.stderr)
+        self.send({"type": "refused", "why": why})
 
-    def _note(self, text):
-        self.refusals.append(text)
-        del self.refusals[:-5]
-
-    def _guarded(self, action, restore=None):
-        """Runs `action`; a refused value is reported and its controls put back (`restore`)."""
+    def receive(self, raw):
+        """A message from the page: checked (viewing/protocol.py), then acted on; a refusal changes nothing."""
         with self.lock:
             try:
-                action()
+                kind, m = parse(raw)
+                if self.session is None:
+                    return
+                getattr(self, "_on_" + kind)(**m)
             except Refused as e:
                 self.refuse(str(e))
-                if restore is not None:
-                    restore()
+            if self.session is not None:
+                self.send({"type": "controls", **self._controls()})
 
-    def toggle(self):
-        with self.lock:
-            self.playing = not self.playing
-            self.clock.resume(self.session.time)
-            self.play.label = "Pause" if self.playing else "Play"
+    def _on_play(self, playing):
+        self.playing = playing
+        self.clock.resume(self.session.time)
 
-    def _gravity(self):
-        sliders = (self.g_size, self.g_turn, self.g_out)
-        size, turn, out = (float(c.value) for c in sliders)
-        t, o = np.radians(turn), np.radians(out)
-        g = size * np.array([np.sin(t) * np.cos(o), -np.cos(t) * np.cos(o), np.sin(o)])
+    def _on_reset(self):
+        self.start(self.scene_name)
 
-        def restore():
-            for c, v in zip(sliders, self.g_good, strict=True):
-                c.value = v
+    def _on_scene(self, name):
+        if name not in self.scenes:
+            raise Refused(f"scene {name!r}: not one of {', '.join(self.scenes)}")
+        self.start(name)
 
-        with self.lock:
-            self._guarded(lambda: self.session.set_gravity(g), restore)
-            if np.array_equal(self.session.gravity, g):
-                self.g_good = (size, turn, out)
+    def _on_gravity(self, size, turn, out):
+        t, o = math.radians(turn), math.radians(out)
+        if self.session.dim == 2 and out != 0.0:
+            raise Refused("gravity: a 2D sheet takes no gravity out of its plane")
+        self.session.set_gravity(size * np.array([math.sin(t) * math.cos(o), -math.cos(t) * math.cos(o), math.sin(o)]))
 
-    def _damping(self):
-        def restore():
-            self.alpha.value, self.beta.value = self.session.damping
+    def _on_damping(self, alpha, beta):
+        self.session.set_damping(alpha, beta)
 
-        self._guarded(lambda: self.session.set_damping(self.alpha.value, self.beta.value), restore)
-
-    def _show_weights(self):
-        """The sliders as the session's weights are (after a refusal or a class change)."""
-        for j, slider in enumerate(self.mode_sliders):
-            slider.value = float(self.session.weights[j])
-
-    def _mode_weight(self, j):
+    def _on_classWeight(self, **m):  # noqa: N802 (the protocol's name)
         w = self.session.weights.copy()
-        w[j] = self.mode_sliders[j].value
-        self._guarded(lambda: self.session.set_weights(w), self._show_weights)
+        w[in_class(self.session, m["class"])] = m["value"]
+        self.session.set_weights(w)
 
-    def _class_weight(self, name):
+    def _on_modeWeight(self, mode, value):  # noqa: N802
+        if not mode < min(self.session.r, MODE_SLIDERS):
+            raise Refused(f"modeWeight.mode: {mode} is not one of the {min(self.session.r, MODE_SLIDERS)} modes with a slider")
         w = self.session.weights.copy()
-        w[in_class(self.session, name)] = self.class_sliders[name].value
+        w[mode] = value
+        self.session.set_weights(w)
 
-        def restore():
-            self.class_sliders[name].value = 1.0
-
-        self._guarded(lambda: self.session.set_weights(w), restore)
-        self._show_weights()
-
-    def _drag_holder(self, k, handle):
-        offset = np.asarray(handle.position, dtype=float) - self.pivots[k]
-        turn = rotation_vector(handle.wxyz)
-        with self.lock:
-            try:
-                self.target[k] = self.session.checked_anchor(k, offset, turn)
-            except Refused as e:
-                self.refuse(str(e))
-
-    def _set_dragging(self, on):
-        with self.lock:
-            self.dragging_load = on
-            if not on:
-                self._guarded(lambda: self.session.set_load(np.zeros(3)))
-
-    def _show_modes(self, first):
-        """Modes first .. first + GALLERY - 1 (modeShapes), each at 0.45 of the sheet's size in a grid beside it,
-        with its frequency; 0: none."""
+    def _on_holder(self, holder, position, quaternion):
         s = self.session
-        for node in self.ghosts:
-            node.remove()
-        self.ghosts = []
-        if not 1 <= first <= s.r:
-            return
-        if self.shapes is None:
-            self.shapes = s.mode_shapes()
-        for k, j in enumerate(range(first, min(first + GALLERY, s.r + 1))):
-            phi = self.shapes[j - 1]
-            scale = 0.2 * self.extent / (np.abs(phi).max() or 1.0)
-            # Left of the sheet (the control panel covers the right of the page), three to a row.
-            center = as3(s.start).mean(axis=0)
-            at = center + np.array([-(2.25 - 0.62 * (k % 3)) * self.extent, 0.25 * self.extent - 0.65 * self.extent * (k // 3), 0.0], dtype=np.float32)
-            x = 0.45 * (as3(s.start + scale * phi) - center) + at
-            name = f"/gallery/mode {j}"
-            if self.big:
-                self.ghosts.append(self.client.scene.add_mesh_simple(name, x, self.faces, color=(150, 150, 150), side="double"))
-            else:
-                self.ghosts.append(self.client.scene.add_line_segments(name, x[s.springs], (150, 150, 150), thickness=0.002))
-            top = at + np.array([0.0, 0.28 * self.extent, 0.0], dtype=np.float32)
-            self.ghosts.append(self.client.scene.add_label(f"/gallery/label {j}", f"mode {j}: {s.frequencies[j - 1]:.2f} Hz", position=top))
+        if holder >= s.n_holders:
+            raise Refused(f"holder {holder}: the scene has {s.n_holders}")
+        offset = np.asarray(position) - self.pivots[holder]
+        turn = rotation_vector(quaternion)
+        if s.dim == 2 and (offset[2] != 0.0 or np.any(turn[:2] != 0.0)):
+            raise Refused("holder: a 2D sheet's holder moves in its plane and turns about z only")
+        self.target[holder] = s.checked_anchor(holder, offset, turn)
+
+    def _on_pull(self, position):
+        s = self.session
+        if position is None:
+            self.pull = None
+            s.set_load(np.zeros(3))
+        else:
+            self.pull = np.asarray(position)[: s.dim]
 
     # ---- stepping -----------------------------------------------------
 
@@ -319,61 +258,90 @@ class Page:
             reach = np.linalg.norm(step[:3])
             if reach > most:
                 step[:3] *= most / reach
+            turn, most = np.linalg.norm(step[3:]), min(HOLDER_TURN, HOLDER_SPEED / self.reach[k]) * s.h
+            if turn > most:
+                step[3:] *= most / turn
             s.set_anchor(k, s.anchors[k][:3] + step[:3], s.anchors[k][3:] + step[3:])
-        if self.dragging_load:
+        if self.pull is not None:
             x = s.positions()[s.load_node]
             pull = np.zeros(3)
-            pull[: s.dim] = (np.asarray(self.load_handle.position)[: s.dim] - x) * (s.weight / PULL_LENGTH)
+            pull[: s.dim] = (self.pull - x) * (s.weight / PULL_LENGTH)
             limit = 0.9 * STRONGEST_PULL * s.weight
             norm = np.linalg.norm(pull)
             s.set_load(pull * min(1.0, limit / norm) if norm > 0 else pull)
 
     def _advance(self):
+        """The steps the clock asks for, for at most STEPPING of a frame's time (a run too slow
+        for real time falls behind, and the page still gets its frames)."""
         s = self.session
         due = self.clock.due(s.time) if self.playing else 0
+        end = time.perf_counter() + STEPPING / self.fps
         for _ in range(due):
+            if time.perf_counter() > end:
+                break
+            anchors = s.anchors.copy()
             self._follow()
             try:
                 s.step()
             except Refused as e:
+                # The FMU kept its last good state, its holders where they were: so do the session and the handles.
+                s.anchors[:] = anchors
+                self.target[:] = anchors
                 self.playing = False
-                self.play.label = "Play"
                 self.refuse(str(e) + " (paused at the last good state)")
+                self.send({"type": "controls", **self._controls(), "anchors": s.anchors.tolist()})  # the handles back too
                 break
 
-    def _draw(self):
+    def placements(self):
+        """Each holder's (R, t): world = R x + t for x in holder 1's frame (holder 1) or at rest (the others)."""
+        s, out = self.session, []
+        for k in range(s.n_holders):
+            r = rotation(s.anchors[k][3:])
+            out.append((r, self.pivots[k] + s.anchors[k][:3] - r @ self.pivots[k]))
+        return out
+
+    def expanded(self, q):
+        """The positions the page draws from q (what view.js computes), (nodes, dimension)."""
         s = self.session
-        x = as3(s.positions())
-        with self.client.atomic():
-            if self.big:
-                self.sheet.vertices = x
-            else:
-                self.sheet.points = x[s.springs]
-                self.nodes.points = x
-            self.held_points.points = x[self.held]
-            self.load_point.points = x[[s.load_node]]
-            if not self.dragging_load:
-                self.load_handle.position = x[s.load_node]
-        self.frames_sent += 1
+        x = as3(self.rest + np.tensordot(q, self.shapes, 1))
+        for k, (r, t) in enumerate(self.placements()):
+            on = self.holder_of == k  # holder 1's frame: its nodes and every free node
+            x[on] = x[on] @ r.T + t
+        return x[:, : s.dim]
+
+    def frame(self):
+        """This frame's binary message."""
+        s = self.session
+        if self.modal:
+            q = self._coordinates()
+            placed = np.concatenate([np.concatenate([r.ravel(), t]) for r, t in self.placements()])
+            return self._binary(MODAL, np.concatenate([q, placed]))
+        return self._binary(POSITIONS, as3(s.positions()).ravel())
+
+    def _check_expansion(self):
+        """A modal run whose expansion is off the FMU's positions gets positions from now on."""
+        if self.modal:
+            off = float(np.abs(self.expanded(self._coordinates()) - self.session.positions()).max())
+            if off > EXPANDS:
+                self.modal = False
+                self.send({"type": "note", "text": f"the modes expand {off:.2g} m off the FMU's positions: positions are sent"})
 
     def _read_out(self):
         s = self.session
         r = s.readouts()
-        lines = [
-            f"**t** = {s.time:.2f} s · **real-time factor** {self.rtf:.2f} · **frames/s** {self.rate:.0f}",
-            f"kinetic {r['kineticEnergy']:.4g} J · potential {r['potentialEnergy']:.4g} J",
-        ]
-        for k in range(s.n_holders):
-            f = r[f"holder {k + 1} force"]
-            lines.append(f"holder {k + 1} force ({f[0]:.3g}, {f[1]:.3g}, {f[2]:.3g}) N")
-        lines.append(
-            f"forceResidual {r['forceResidual']:.3g} · trainingRange {r['trainingRange']:.3g} · "
-            f"errorEstimate {r['errorEstimate']:.3g} · reducedFraction {r['reducedFraction']:.3g}"
+        self.send(
+            {
+                "type": "readouts",
+                "time": s.time,
+                "rtf": self.rtf,
+                "rate": self.rate,
+                "playing": self.playing,
+                "readouts": finite(r),
+                "warnings": [f"{status}: {text}" for status, _, text in s.messages if status != "OK"][-5:],
+                "refusals": self.refusals[-5:],
+                "expanded": self.modal,
+            }
         )
-        lines.append("paused" if not self.playing else "running")
-        self.readout.content = "  \n".join(lines)
-        shown = [f"{status}: {text}" for status, _, text in s.messages if status != "OK"][-5:] + self.refusals[-5:]
-        self.log.content = "  \n".join(shown)
 
     def _loop(self):
         period = 1.0 / self.fps
@@ -384,11 +352,15 @@ class Page:
                 if self.session is None:
                     break
                 self._advance()
-                self._draw()
+                if self.session.time != self.sent_time:  # paused: nothing new to draw
+                    self.send(self.frame())
+                    self.frames_sent += 1
+                    self.sent_time = self.session.time
                 now = time.perf_counter()
                 if now - mark >= 0.5:
                     self.rate = (self.frames_sent - frames0) / (now - mark)
                     self.rtf = (self.session.time - sim0) / (now - mark) if self.playing else 0.0
+                    self._check_expansion()
                     self._read_out()
                     mark, frames0, sim0 = now, self.frames_sent, self.session.time
             next_frame += period
@@ -425,3 +397,11 @@ class Page:
                 "holder_force": s.readouts()["holder 1 force"] if s else None,
             }
 
+
+def finite(value):
+    """Numbers that are not finite as null (JSON has no NaN)."""
+    if isinstance(value, dict):
+        return {k: finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [finite(v) for v in value]
+    return value if not isinstance(value, float) or math.isfinite(value) else None

@@ -79,7 +79,8 @@ pub fn control(args: &[String]) -> Result<(), String> {
 const VIEW_USAGE: &str = "\
 usage: cargo xtask view [--] [--scene NAME] [--set NAME=VALUE ...] [--port P] [--fps F] [--no-open]
 
-Installs what it needs (viser), builds target/fmu/ModalMassSpring.fmu and
+Installs what it needs (aiohttp; the page's three.js and lil-gui come from
+the npm registry on first use), builds target/fmu/ModalMassSpring.fmu and
 runs python/view.py on it: a server on 127.0.0.1 that runs one FMU instance
 per browser page in real time, draws the sheet and lets the page steer it
 (mode weights and classes, gravity, damping, the holders, the load node).

@@ -12,8 +12,8 @@
 //!   driver, the browser the view's tests drive headless (with selenium).
 //! - The Python environment `.venv` in the repository root: fmpy, numpy and
 //!   matplotlib to run the main job; dask.distributed for parameter sweeps
-//!   (`cargo xtask sweep`, python/sweep.py); viser for the live view
-//!   (`cargo xtask view`, python/view.py); for the tests pytest and
+//!   (`cargo xtask sweep`, python/sweep.py); aiohttp for the live view's
+//!   server (`cargo xtask view`, python/view.py); for the tests pytest and
 //!   fmu-manipulation-toolbox (its `fmucontainer` is one of the co-simulation
 //!   masters `tests/python/test_chain.py` runs the FMU under) and ecospy
 //!   (the Ecos co-simulation engine, `tests/python/test_ecos.py`); ruff,
@@ -65,8 +65,10 @@ const PYTHON_PACKAGES: &[(&str, &str, Purpose)] = &[
     ("numpy", "numpy", Purpose::Run),
     ("matplotlib", "matplotlib", Purpose::Run),
     ("distributed", "dask[distributed]==2026.8.0", Purpose::Sweep),
-    // the live view's server and its bundled three.js client
-    ("viser", "viser==1.1.1", Purpose::View),
+    // the live view's server (static files and websockets on one port); its
+    // page's three.js and lil-gui come from the npm registry on first use
+    // (python/viewing/assets.py, checked against pinned sha512s)
+    ("aiohttp", "aiohttp==3.14.5", Purpose::View),
     ("selenium", "selenium==4.51.0", Purpose::Test),
     ("pytest", "pytest", Purpose::Test),
     ("fmu_manipulation_toolbox", "fmu_manipulation_toolbox==2.0", Purpose::Test),
