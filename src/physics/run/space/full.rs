@@ -25,6 +25,7 @@ use crate::physics::settings::Settings;
 use crate::physics::setup::basis;
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
+use crate::physics::vector_unit;
 
 /// The constant model of the full-space equations.
 pub struct Full {
@@ -196,6 +197,7 @@ impl Full {
         let stack = MemStack::new(&mut w.mem);
         let llt = self.symbolic.factorize_numeric_llt(&mut w.l_values, a, Side::Upper, LltRegularization::default(), Par::Seq, stack, Default::default());
         w.indefinite = llt.is_err();
+        vector_unit::clean();
         if !w.indefinite {
             return Ok(());
         }
@@ -206,7 +208,7 @@ impl Full {
         let regularization = LdltRegularization { dynamic_regularization_signs: None, dynamic_regularization_delta: 0.0, dynamic_regularization_epsilon: 0.0 };
         self.symbolic
             .factorize_numeric_ldlt(&mut w.l_values, a, Side::Upper, regularization, Par::Seq, stack, Default::default())
-            .map(|_| ())
+            .map(|_| vector_unit::clean())
             .map_err(|_| StepFailure::Buckled)
     }
 }
@@ -469,6 +471,7 @@ impl Space for Full {
         } else {
             LltRef::<usize, f64>::new(&self.symbolic, &w.l_values).solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
         }
+        vector_unit::clean();
     }
 
     fn omega_sq_bound(&self, _w: &FullWork) -> f64 {
