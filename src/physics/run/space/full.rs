@@ -274,6 +274,27 @@ impl Full {
 /// Iterates of the Coriolis velocity update before a step is refused.
 const MAX_CORIOLIS_ITERATIONS: usize = 100;
 
+impl Full {
+    /// h = f_springs(x) + M g + f_p at the slot positions in `w` (gravity
+    /// and the springs in one pass, as adding the springs to a copy of
+    /// gravity); turning, the centrifugal force joins it.
+    fn force_at_slots(&self, w: &mut FullWork, h: &mut [f64]) {
+        w.elastic = self.springs.set_to(&self.scene, &w.x, &mut w.springs, &w.gravity, h);
+        if w.turning {
+            let (d, spin) = (self.scene.dim, w.spin);
+            let w2 = dot(&spin, &spin);
+            for (k, hk) in h.chunks_exact_mut(d).enumerate() {
+                let m = self.scene.dof_mass[k * d];
+                let rho: [f64; 3] = std::array::from_fn(|i| if i < d { w.x[k * d + i] - self.pivot[i] } else { 0.0 });
+                let along = dot(&spin, &rho);
+                for i in 0..d {
+                    hk[i] += m * (w2 * rho[i] - spin[i] * along);
+                }
+            }
+        }
+    }
+}
+
 impl Constants for Full {
     fn scene(&self) -> &Scene {
         &self.scene
@@ -386,20 +407,36 @@ impl Space for Full {
         for k in 0..u.len() {
             w.x[k] = self.scene.rest[k] + u[k];
         }
-        h.copy_from_slice(&w.gravity);
-        w.elastic = self.springs.add_to(&self.scene, &w.x, &mut w.springs, h);
-        if w.turning {
-            let (d, spin) = (self.scene.dim, w.spin);
-            let w2 = dot(&spin, &spin);
-            for (k, hk) in h.chunks_exact_mut(d).enumerate() {
-                let m = self.scene.dof_mass[k * d];
-                let rho: [f64; 3] = std::array::from_fn(|i| if i < d { w.x[k * d + i] - self.pivot[i] } else { 0.0 });
-                let along = dot(&spin, &rho);
-                for i in 0..d {
-                    hk[i] += m * (w2 * rho[i] - spin[i] * along);
-                }
-            }
+        self.force_at_slots(w, h);
+    }
+
+    /// The predictor and x = x* + u1 in one pass, then h as [`Self::force`].
+    fn predicted_force(&self, y: &[f64], v: &[f64], a: &[f64], dt: f64, y1: &mut [f64], w: &mut FullWork, h: &mut [f64]) {
+        let half_dt2 = 0.5 * dt * dt;
+        for k in 0..y1.len() {
+            y1[k] = y[k] + dt * v[k] + half_dt2 * a[k];
+            w.x[k] = self.scene.rest[k] + y1[k];
         }
+        self.force_at_slots(w, h);
+    }
+
+    /// Without stiffness-proportional damping and not turning, v1 and the
+    /// new a in one pass: v1 = (M (v + dt/2 a) + dt/2 h) / (M (1 + dt/2 alpha)),
+    /// a1 = (h - alpha M v1) / M, each DOF as the two calls compute it.
+    fn explicit_rates(&self, dt: f64, v: &[f64], a: &mut [f64], h: &[f64], w: &mut FullWork, v1: &mut [f64]) -> Result<(), StepFailure> {
+        if w.turning || w.beta != 0.0 {
+            self.explicit_velocity(dt, v, a, h, w, v1)?;
+            self.acceleration(v1, h, w, a);
+            return Ok(());
+        }
+        let (mass, alpha) = (&self.scene.dof_mass, w.alpha);
+        for k in 0..v1.len() {
+            let m = mass[k];
+            let vk = (m * (v[k] + 0.5 * dt * a[k]) + 0.5 * dt * h[k]) / (m * (1.0 + 0.5 * dt * alpha));
+            v1[k] = vk;
+            a[k] = (h[k] - alpha * m * vk) / m;
+        }
+        Ok(())
     }
 
     /// Turning, (M + dt/2 C + dt M [Omega]x) v1 = the same right side: the
