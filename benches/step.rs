@@ -46,7 +46,8 @@
 //!   symplectic velocity and position update). Criterion reports each per
 //!   internal step, with springs per second as the throughput; the group
 //!   then times both alternately in one run and prints the ns per spring
-//!   of each and their ratio.
+//!   of each and their ratio; the FMU on 1 and on 2 threads (`threads`),
+//!   whose trajectories it checks to be the same, bit for bit.
 //!
 //! cargo bench --bench step
 
@@ -419,15 +420,15 @@ fn adaptive(c: &mut Criterion) {
 
 /// An instance of the cloth-3d scene on an n x n grid in full space,
 /// explicit, structural and shear springs, no auxiliary springs, the
-/// residual check off, internal steps of `dt`, initialized at t = 0.
-fn full_space_instance(n: u64, dt: f64) -> fmi3Instance {
+/// residual check off, internal steps of `dt`, on `threads` threads, initialized at t = 0.
+fn full_space_instance(n: u64, dt: f64, threads: u64) -> fmi3Instance {
     let (name, token) = (CString::new("bench").unwrap(), CString::new(INSTANTIATION_TOKEN).unwrap());
     let inst =
         unsafe { fmi3InstantiateCoSimulation(name.as_ptr(), token.as_ptr(), null(), false, false, false, false, null(), 0, null_mut(), Some(silent), None) };
     assert!(!inst.is_null());
     let ok = fmi3Status_fmi3OK;
     unsafe {
-        for (r, v) in [(vr::NX, n), (vr::NY, n), (vr::DIMENSION, 3), (vr::N_MODES, 1)] {
+        for (r, v) in [(vr::NX, n), (vr::NY, n), (vr::DIMENSION, 3), (vr::N_MODES, 1), (vr::THREADS, threads)] {
             assert_eq!(fmi3SetUInt64(inst, &r, 1, &v, 1), ok);
         }
         for (r, v) in [(vr::REDUCTION, 2i64), (vr::INTEGRATOR, 1)] {
@@ -527,14 +528,25 @@ fn full_space(c: &mut Criterion) {
         let scene = grid.build().unwrap();
         let springs = scene.springs.len();
         let mut plain = PlainLoop::new(&scene);
-        let inst = full_space_instance(n, DT);
+        let insts = [full_space_instance(n, DT, 1), full_space_instance(n, DT, 2)];
         let h = DT * INTERNAL as f64;
-        let mut time = 0.0;
+        let mut times = [0.0; 2];
+        // The trajectory is the same on 1 and 2 threads, bit for bit.
+        let mut positions = [vec![0.0; 3 * (n * n) as usize], vec![0.0; 3 * (n * n) as usize]];
+        for ((&inst, x), time) in insts.iter().zip(positions.iter_mut()).zip(times.iter_mut()) {
+            steps(inst, 5, h, time, None);
+            assert_eq!(unsafe { fmi3GetFloat64(inst, &vr::POSITIONS, 1, x.as_mut_ptr(), x.len()) }, fmi3Status_fmi3OK);
+        }
+        assert!(positions[0] == positions[1], "1 and 2 threads differ");
         let mut group = c.benchmark_group(format!("full_space/cloth-3d-{n}x{n}"));
         group.sample_size(10);
         group.throughput(criterion::Throughput::Elements(springs as u64));
         let label = format!("{springs} springs");
-        group.bench_function(BenchmarkId::new("fmi3DoStep", &label), |b| b.iter_custom(|iters| steps(inst, iters, h, &mut time, None) / INTERNAL));
+        for (t, (&inst, time)) in insts.iter().zip(times.iter_mut()).enumerate() {
+            group.bench_function(BenchmarkId::new(format!("fmi3DoStep, {} thread(s)", t + 1), &label), |b| {
+                b.iter_custom(|iters| steps(inst, iters, h, time, None) / INTERNAL)
+            });
+        }
         group.bench_function(BenchmarkId::new("plain loop", &label), |b| {
             b.iter_custom(|iters| {
                 let t = Instant::now();
@@ -545,16 +557,17 @@ fn full_space(c: &mut Criterion) {
             })
         });
         group.finish();
+        let per_spring = |t: Duration, calls: u64| t.as_secs_f64() * 1e9 / (calls as f64 * INTERNAL as f64 * springs as f64);
         if !wanted(&format!("full_space/cloth-3d-{n}x{n}")) {
-            unsafe { fmi3FreeInstance(inst) };
+            insts.iter().for_each(|&i| unsafe { fmi3FreeInstance(i) });
             continue;
         }
-        // Alternately, in one run: ns per spring of each, and the ratio.
+        // Alternately, in one run: ns per spring of each, and the ratios.
         let calls = if n == 100 { 40 } else { 4 };
-        let (mut fmu, mut yard) = (Vec::new(), Vec::new());
+        let (mut fmu, mut fmu2, mut yard) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..7 {
-            let t = steps(inst, calls, h, &mut time, None);
-            fmu.push(t.as_secs_f64() * 1e9 / (calls as f64 * INTERNAL as f64 * springs as f64));
+            fmu.push(per_spring(steps(insts[0], calls, h, &mut times[0], None), calls));
+            fmu2.push(per_spring(steps(insts[1], calls, h, &mut times[1], None), calls));
             let t = Instant::now();
             for _ in 0..calls * INTERNAL as u64 {
                 plain.step(DT);
@@ -562,9 +575,13 @@ fn full_space(c: &mut Criterion) {
             yard.push(t.elapsed().as_secs_f64() * 1e9 / (calls as f64 * INTERNAL as f64 * springs as f64));
         }
         assert!(plain.x.iter().all(|x| x.is_finite()));
-        let (f, y) = (median(fmu), median(yard));
-        println!("full_space/cloth-3d-{n}x{n}: {springs} springs, fmi3DoStep {f:.2} ns/spring, plain loop {y:.2} ns/spring, ratio {:.2}", f / y);
-        unsafe { fmi3FreeInstance(inst) };
+        let (f, f2, y) = (median(fmu), median(fmu2), median(yard));
+        println!(
+            "full_space/cloth-3d-{n}x{n}: {springs} springs, fmi3DoStep {f:.2} ns/spring on 1 thread ({:.2}x the plain loop), {f2:.2} on 2 threads ({:.2}x faster than 1), plain loop {y:.2} ns/spring",
+            f / y,
+            f / f2
+        );
+        insts.iter().for_each(|&i| unsafe { fmi3FreeInstance(i) });
     }
 }
 

@@ -88,6 +88,7 @@ pub trait Space: Constants + Send + Sized + 'static {
     fn acceleration(&self, v: &[f64], h: &[f64], w: &mut Self::Work, a: &mut [f64]);
     /// The Newmark predictor y1 = y + dt v + dt^2/2 a, then h(y1) into `h`
     /// (as [`Self::force`]); a space may fuse the two passes, to the same bits.
+    #[allow(clippy::too_many_arguments)]
     fn predicted_force(&self, y: &[f64], v: &[f64], a: &[f64], dt: f64, y1: &mut [f64], w: &mut Self::Work, h: &mut [f64]) {
         let half_dt2 = 0.5 * dt * dt;
         for i in 0..y1.len() {
