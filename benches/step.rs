@@ -17,6 +17,11 @@
 //! - `residual_check/cloth-3d-NxN`: `fmi3DoStep` of the cloth with 16 modes
 //!   of the load, a static correction and cubature forces, as a host gets it
 //!   (the default `forceResidualLimit`) and with the check off, 0.01 s steps;
+//! - `residual_run/cloth-3d-300x300`: the same instance over a whole run of
+//!   30 s in 0.01 s calls from the state after set-up (restored before each
+//!   run, untimed: the check's warm-up after a restore is that after set-up),
+//!   the default forceResidualLimit against the check off, alternately in
+//!   one run; prints the mean per call of each and their ratio.
 //! - `trained/cloth-3d-NxN`: `fmi3DoStep` of the cloth with 16 trained
 //!   vectors (`modeSelection = trained`), exact and cubature forces, default
 //!   settings otherwise, without and with the node positions read after each step.
@@ -32,6 +37,17 @@
 //!   untimed), default settings otherwise: full space, the best fixed
 //!   reduced setting (16 trained vectors, cubature forces on 100 x 100, exact
 //!   on 30 x 30), and `reduction = adaptive` (its set-up excluded).
+//!
+//! - `full_space/cloth-3d-NxN` (N = 100, 300): the explicit full-space
+//!   internal step through `fmi3DoStep` (ten internal steps of 1e-4 s per
+//!   call, structural and shear springs, no auxiliary springs, the residual
+//!   check off) beside the yardstick, a plain scalar loop over the same
+//!   springs (one pass of spring forces into a force array, then a
+//!   symplectic velocity and position update). Criterion reports each per
+//!   internal step, with springs per second as the throughput; the group
+//!   then times both alternately in one run and prints the ns per spring
+//!   of each and their ratio; the FMU on 1 and on 2 threads (`threads`),
+//!   whose trajectories it checks to be the same, bit for bit.
 //!
 //! cargo bench --bench step
 
@@ -308,6 +324,42 @@ fn residual_check(c: &mut Criterion) {
     }
 }
 
+fn residual_run(c: &mut Criterion) {
+    let _ = c;
+    let n = 300u64;
+    if !wanted(&format!("residual_run/cloth-3d-{n}x{n}")) {
+        return;
+    }
+    const CALLS: u64 = 3000;
+    let mut runs = Vec::new();
+    for limit in [0.9, 0.0] {
+        let inst = cloth_instance(n, limit);
+        let mut start: fmi3FMUState = null_mut();
+        assert_eq!(unsafe { fmi3GetFMUState(inst, &mut start) }, fmi3Status_fmi3OK);
+        runs.push((inst, start, Vec::new()));
+    }
+    for _ in 0..5 {
+        for (inst, start, times) in runs.iter_mut() {
+            assert_eq!(unsafe { fmi3SetFMUState(*inst, *start) }, fmi3Status_fmi3OK);
+            let mut time = 0.0;
+            times.push(steps(*inst, CALLS, 0.01, &mut time, None).as_secs_f64() * 1e6 / CALLS as f64);
+        }
+    }
+    let (on, off) = (median(runs[0].2.clone()), median(runs[1].2.clone()));
+    println!(
+        "residual_run/cloth-3d-{n}x{n}: 30 s in 0.01 s calls, median of 5 runs: default forceResidualLimit {on:.2} us per call, check off {off:.2} us per call, ratio {:.2} (runs on: {:.2?}, off: {:.2?})",
+        on / off,
+        runs[0].2,
+        runs[1].2
+    );
+    for (inst, mut start, _) in runs {
+        unsafe {
+            fmi3FreeFMUState(inst, &mut start);
+            fmi3FreeInstance(inst);
+        }
+    }
+}
+
 /// `fmi3DoStep` of 0.01 s on the cloth with 16 trained vectors, exact
 /// and cubature forces, every other value at its default (the residual
 /// check and the trained range's check on), as a host gets it; and with the
@@ -366,9 +418,176 @@ fn adaptive(c: &mut Criterion) {
     }
 }
 
+/// An instance of the cloth-3d scene on an n x n grid in full space,
+/// explicit, structural and shear springs, no auxiliary springs, the
+/// residual check off, internal steps of `dt`, on `threads` threads, initialized at t = 0.
+fn full_space_instance(n: u64, dt: f64, threads: u64) -> fmi3Instance {
+    let (name, token) = (CString::new("bench").unwrap(), CString::new(INSTANTIATION_TOKEN).unwrap());
+    let inst =
+        unsafe { fmi3InstantiateCoSimulation(name.as_ptr(), token.as_ptr(), null(), false, false, false, false, null(), 0, null_mut(), Some(silent), None) };
+    assert!(!inst.is_null());
+    let ok = fmi3Status_fmi3OK;
+    unsafe {
+        for (r, v) in [(vr::NX, n), (vr::NY, n), (vr::DIMENSION, 3), (vr::N_MODES, 1), (vr::THREADS, threads)] {
+            assert_eq!(fmi3SetUInt64(inst, &r, 1, &v, 1), ok);
+        }
+        for (r, v) in [(vr::REDUCTION, 2i64), (vr::INTEGRATOR, 1)] {
+            assert_eq!(fmi3SetInt64(inst, &r, 1, &v, 1), ok);
+        }
+        assert_eq!(fmi3SetBoolean(inst, &vr::SHEAR_SPRINGS, 1, &true, 1), ok);
+        for (r, v) in [(vr::AUX_STIFFNESS, 0.0), (vr::FORCE_RESIDUAL_LIMIT, 0.0), (vr::MAX_INTERNAL_STEP, dt)] {
+            assert_eq!(fmi3SetFloat64(inst, &r, 1, &v, 1), ok);
+        }
+        assert_eq!(fmi3EnterInitializationMode(inst, false, 0.0, 0.0, false, 0.0), ok);
+        assert_eq!(fmi3ExitInitializationMode(inst), ok);
+    }
+    inst
+}
+
+/// The yardstick of the full space: the springs of the same scene in one
+/// plain scalar pass (forces into a force array, gravity first), then a
+/// symplectic Euler update of the free nodes, v += dt f / m, x += dt v.
+struct PlainLoop {
+    springs: Vec<(u32, u32, f64, f64)>,
+    n_free: usize,
+    x: Vec<f64>,
+    v: Vec<f64>,
+    f: Vec<f64>,
+    mass: Vec<f64>,
+    gravity: [f64; 3],
+}
+
+impl PlainLoop {
+    fn new(scene: &Scene) -> Self {
+        assert_eq!(scene.dim, 3);
+        let n = scene.n_free * 3;
+        PlainLoop {
+            springs: scene.springs.iter().map(|s| (s.a as u32, s.b as u32, s.k, s.rest)).collect(),
+            n_free: scene.n_free,
+            x: scene.rest.clone(),
+            v: vec![0.0; n],
+            f: vec![0.0; scene.rest.len()],
+            mass: scene.dof_mass[..n].to_vec(),
+            gravity: [0.0, -9.81, 0.0],
+        }
+    }
+
+    fn step(&mut self, dt: f64) {
+        let n = self.n_free * 3;
+        for (k, f) in self.f.iter_mut().enumerate() {
+            *f = if k < n { self.mass[k] * self.gravity[k % 3] } else { 0.0 };
+        }
+        let (x, f) = (&self.x, &mut self.f);
+        for &(a, b, k, l0) in &self.springs {
+            let (a, b) = (3 * a as usize, 3 * b as usize);
+            let d = [x[b] - x[a], x[b + 1] - x[a + 1], x[b + 2] - x[a + 2]];
+            let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            let t = k * (l - l0) / l;
+            for i in 0..3 {
+                f[a + i] += t * d[i];
+                f[b + i] -= t * d[i];
+            }
+        }
+        for k in 0..n {
+            self.v[k] += dt * self.f[k] / self.mass[k];
+            self.x[k] += dt * self.v[k];
+        }
+    }
+}
+
+/// The filter on the command line (`cargo bench --bench step -- FILTER`)
+/// selects `name`: the printed summaries follow criterion's filter.
+fn wanted(name: &str) -> bool {
+    std::env::args().skip(1).filter(|a| !a.starts_with('-')).all(|f| name.contains(&f))
+}
+
+/// Median of `samples`.
+fn median(mut samples: Vec<f64>) -> f64 {
+    samples.sort_by(f64::total_cmp);
+    samples[samples.len() / 2]
+}
+
+fn full_space(c: &mut Criterion) {
+    const DT: f64 = 1e-4;
+    const INTERNAL: u32 = 10;
+    for n in [100u64, 300] {
+        let grid = Grid {
+            columns: n as usize,
+            rows: n as usize,
+            dim: 3,
+            spacing: 0.1,
+            node_mass: 0.01,
+            spring_stiffness: 50.0,
+            shear_springs: true,
+            bending_springs: false,
+            aux_stiffness: 0.0,
+            fixed_nodes: FixedNodes::TopRow,
+            holders: 1,
+            holder_of_node: Vec::new(),
+        };
+        let scene = grid.build().unwrap();
+        let springs = scene.springs.len();
+        let mut plain = PlainLoop::new(&scene);
+        let insts = [full_space_instance(n, DT, 1), full_space_instance(n, DT, 2)];
+        let h = DT * INTERNAL as f64;
+        let mut times = [0.0; 2];
+        // The trajectory is the same on 1 and 2 threads, bit for bit.
+        let mut positions = [vec![0.0; 3 * (n * n) as usize], vec![0.0; 3 * (n * n) as usize]];
+        for ((&inst, x), time) in insts.iter().zip(positions.iter_mut()).zip(times.iter_mut()) {
+            steps(inst, 5, h, time, None);
+            assert_eq!(unsafe { fmi3GetFloat64(inst, &vr::POSITIONS, 1, x.as_mut_ptr(), x.len()) }, fmi3Status_fmi3OK);
+        }
+        assert!(positions[0] == positions[1], "1 and 2 threads differ");
+        let mut group = c.benchmark_group(format!("full_space/cloth-3d-{n}x{n}"));
+        group.sample_size(10);
+        group.throughput(criterion::Throughput::Elements(springs as u64));
+        let label = format!("{springs} springs");
+        for (t, (&inst, time)) in insts.iter().zip(times.iter_mut()).enumerate() {
+            group.bench_function(BenchmarkId::new(format!("fmi3DoStep, {} thread(s)", t + 1), &label), |b| {
+                b.iter_custom(|iters| steps(inst, iters, h, time, None) / INTERNAL)
+            });
+        }
+        group.bench_function(BenchmarkId::new("plain loop", &label), |b| {
+            b.iter_custom(|iters| {
+                let t = Instant::now();
+                for _ in 0..iters {
+                    plain.step(DT);
+                }
+                t.elapsed()
+            })
+        });
+        group.finish();
+        let per_spring = |t: Duration, calls: u64| t.as_secs_f64() * 1e9 / (calls as f64 * INTERNAL as f64 * springs as f64);
+        if !wanted(&format!("full_space/cloth-3d-{n}x{n}")) {
+            insts.iter().for_each(|&i| unsafe { fmi3FreeInstance(i) });
+            continue;
+        }
+        // Alternately, in one run: ns per spring of each, and the ratios.
+        let calls = if n == 100 { 40 } else { 4 };
+        let (mut fmu, mut fmu2, mut yard) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..7 {
+            fmu.push(per_spring(steps(insts[0], calls, h, &mut times[0], None), calls));
+            fmu2.push(per_spring(steps(insts[1], calls, h, &mut times[1], None), calls));
+            let t = Instant::now();
+            for _ in 0..calls * INTERNAL as u64 {
+                plain.step(DT);
+            }
+            yard.push(t.elapsed().as_secs_f64() * 1e9 / (calls as f64 * INTERNAL as f64 * springs as f64));
+        }
+        assert!(plain.x.iter().all(|x| x.is_finite()));
+        let (f, f2, y) = (median(fmu), median(fmu2), median(yard));
+        println!(
+            "full_space/cloth-3d-{n}x{n}: {springs} springs, fmi3DoStep {f:.2} ns/spring on 1 thread ({:.2}x the plain loop), {f2:.2} on 2 threads ({:.2}x faster than 1), plain loop {y:.2} ns/spring",
+            f / y,
+            f / f2
+        );
+        insts.iter().for_each(|&i| unsafe { fmi3FreeInstance(i) });
+    }
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(2));
-    targets = do_step, internal_step, cubature, residual_check, trained, holders, adaptive
+    targets = full_space, residual_run, do_step, internal_step, cubature, residual_check, trained, holders, adaptive
 }
 criterion_main!(benches);

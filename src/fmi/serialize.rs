@@ -30,10 +30,10 @@ pub const MAGIC: &[u8; 8] = b"MMSFMU3S";
 /// 5: the holder's orientation and spin, and its target; 6: holders 2 to 4
 /// (their motions in the state, their targets among the loads) and the
 /// variables that set them; 7: the variables of a later table (those with
-/// `since_format` 7); 8: an adaptive run's part after the loads. Formats 5 to 7
-/// are still read: the holders 2 to 4 of format 5 are at rest and the
-/// variables a format lacks take their start values.
-pub const VERSION: u32 = 8;
+/// `since_format` 7); 8: an adaptive run's part after the loads; 9: the
+/// variables of a later table again (`since_format` 9). Formats 5 to 8 are still read: the holders 2 to 4 of
+/// format 5 are at rest and the variables a format lacks take their start values.
+pub const VERSION: u32 = 9;
 /// The oldest format read.
 pub const OLDEST: u32 = 5;
 /// Bytes before the payload.

@@ -75,6 +75,7 @@ impl Params {
             max_internal_step: self.scalar(vr::MAX_INTERNAL_STEP),
             substepping: true,
             constraint_modes: true,
+            threads: self.count(vr::THREADS),
             training: TrainingProgram { scale: self.scalar(vr::TRAINING_SCALE), tilt: self.scalar(vr::TRAINING_TILT), time: self.scalar(vr::TRAINING_TIME) },
         }
     }

@@ -10,13 +10,15 @@
 //! - [`run`]: what steps and reads the sheet (spaces, schemes, the
 //!   simulator, forces, the holder's frame, state);
 //!
-//! and beside them [`settings`] (every choice of a set-up, in one type) and
+//! and beside them [`vector_unit`] (the CPU's vector state after faer's kernels),
+//! [`settings`] (every choice of a set-up, in one type) and
 //! [`error`] (typed errors that name the quantity and the limit).
 
 pub mod error;
 pub mod run;
 pub mod settings;
 pub mod setup;
+pub mod vector_unit;
 
 pub use error::{HolderProblem, PhysicsError, Quantity, StepFailure};
 pub use run::integrator::EXPLICIT_SAFETY;

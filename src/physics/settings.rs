@@ -56,6 +56,10 @@ pub struct Settings {
     /// constraint modes of the holders join the basis (`docs/method.md`,
     /// section 9). Only tests and the study switch this off, to measure what they bring.
     pub constraint_modes: bool,
+    /// Threads of the full space's spring forces and node updates (1: the
+    /// caller's thread alone). The trajectory is bit for bit the same for
+    /// any count; only the elastic energy's sum is ordered differently.
+    pub threads: usize,
 }
 
 /// The range a trained basis is trained for (`docs/method.md`, section 3;
@@ -103,6 +107,7 @@ impl Settings {
             substepping: true,
             training: TrainingProgram::default(),
             constraint_modes: true,
+            threads: start::THREADS,
         }
     }
 }

@@ -22,6 +22,7 @@ INTERFACE = {
     "bendingSprings": ("Boolean", "parameter", "fixed"),
     "auxStiffness": ("Float64", "parameter", "fixed"),
     "maxInternalStep": ("Float64", "parameter", "fixed"),
+    "threads": ("UInt64", "parameter", "fixed"),
     "fixedNodes": ("Enumeration", "parameter", "fixed"),
     "reduction": ("Enumeration", "parameter", "fixed"),
     "integrator": ("Enumeration", "parameter", "fixed"),

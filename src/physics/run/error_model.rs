@@ -48,6 +48,7 @@ use faer::{Conj, MatMut, Par, Side};
 
 use crate::physics::error::PhysicsError;
 use crate::physics::run::forces::StiffnessPattern;
+use crate::physics::vector_unit;
 
 /// e, e', e'' of the error model: the part of an adaptive run's state that
 /// estimates its error.
@@ -162,6 +163,7 @@ impl ErrorModel {
         self.symbolic
             .factorize_numeric_llt(&mut self.l_values, a, Side::Upper, LltRegularization::default(), Par::Seq, stack, Default::default())
             .map_err(|e| PhysicsError::LinearAlgebra { what: "Cholesky factorization of the error model", detail: format!("{e:?}") })?;
+        vector_unit::clean();
         self.factored = h;
         Ok(())
     }
@@ -185,6 +187,7 @@ impl ErrorModel {
             Par::Seq,
             stack,
         );
+        vector_unit::clean();
         s.correct(h, &self.rhs);
         Ok(())
     }

@@ -9,7 +9,7 @@
 //!
 //! One force evaluation per step; stable while dt omega_max < 2 (undamped).
 
-use super::scheme::{predict, Buffers, Scheme, EXPLICIT_SAFETY};
+use super::scheme::{Buffers, Scheme, EXPLICIT_SAFETY};
 use crate::physics::error::StepFailure;
 use crate::physics::run::space::Space;
 use crate::physics::run::state::State;
@@ -27,10 +27,8 @@ impl Scheme for NewmarkExplicit {
     }
 
     fn step<S: Space>(space: &S, w: &mut S::Work, buf: &mut Buffers, state: &mut State, dt: f64) -> Result<(), StepFailure> {
-        predict(&state.y, &state.v, &state.a, dt, &mut buf.y1);
-        space.force(&buf.y1, w, &mut buf.h);
-        space.explicit_velocity(dt, &state.v, &state.a, &buf.h, w, &mut buf.v1)?;
-        space.acceleration(&buf.v1, &buf.h, w, &mut state.a);
+        space.predicted_force(&state.y, &state.v, &state.a, dt, &mut buf.y1, w, &mut buf.h);
+        space.explicit_rates(dt, &state.v, &mut state.a, &buf.h, w, &mut buf.v1)?;
         std::mem::swap(&mut state.v, &mut buf.v1);
         std::mem::swap(&mut state.y, &mut buf.y1);
         Ok(())

@@ -13,6 +13,7 @@ use crate::physics::settings::{ForceEvaluation, Integrator, ModeSelection, Reduc
 use crate::physics::setup::scene::Scene;
 use crate::physics::setup::setup_data::SetupData;
 use crate::physics::setup::{adaptive_basis, cubature_training, trained_basis};
+use crate::physics::vector_unit;
 
 /// The run the settings chose, behind [`Sheet`]: every method of
 /// [`Steps`], [`Reads`] and [`SetUp`] is called on it directly.
@@ -37,7 +38,10 @@ impl Simulator {
         }
         loads.validate(settings.n_modes)?;
         loads.validate_on(&scene)?;
-        Ok(Simulator(build(scene, settings, loads, prebuilt)?))
+        let sheet = build(scene, settings, loads, prebuilt)?;
+        // The set-up's faer kernels leave the vector unit's upper state dirty: clean for the host and the steps.
+        vector_unit::clean();
+        Ok(Simulator(sheet))
     }
 
     /// New loads, effective from now (see [`Steps::edit_loads`]).

@@ -13,6 +13,7 @@ use crate::physics::run::space::Readout;
 use crate::physics::run::state::{Loads, Motion, Snapshot, State, OTHER_HOLDERS};
 use crate::physics::settings::Settings;
 use crate::physics::setup::scene::Scene;
+use crate::physics::vector_unit;
 
 impl<S: Readout, I: Scheme> Run<S, I> {
     /// Binds `space` to the scheme under `loads` (or refuses a space the
@@ -350,6 +351,8 @@ impl<S: Readout, I: Scheme> Steps for Run<S, I> {
 
     fn do_step(&mut self, h: f64) -> Result<(), PhysicsError> {
         positive(Quantity::StepSize, h)?;
+        // Set-up, a restore or a read may have run faer's kernels since the last step.
+        vector_unit::clean();
         let dt_max = self.max_stable_step();
         let steps = if self.settings.substepping { internal_step_count(h, dt_max) } else { 1.0 };
         if steps > MAX_INTERNAL_STEPS_PER_CALL as f64 {

@@ -86,6 +86,25 @@ pub trait Space: Constants + Send + Sized + 'static {
     fn explicit_velocity(&self, dt: f64, v: &[f64], a: &[f64], h: &[f64], w: &mut Self::Work, v1: &mut [f64]) -> Result<(), StepFailure>;
     /// a from M a = h - C v.
     fn acceleration(&self, v: &[f64], h: &[f64], w: &mut Self::Work, a: &mut [f64]);
+    /// The Newmark predictor y1 = y + dt v + dt^2/2 a, then h(y1) into `h`
+    /// (as [`Self::force`]); a space may fuse the two passes, to the same bits.
+    #[allow(clippy::too_many_arguments)]
+    fn predicted_force(&self, y: &[f64], v: &[f64], a: &[f64], dt: f64, y1: &mut [f64], w: &mut Self::Work, h: &mut [f64]) {
+        let half_dt2 = 0.5 * dt * dt;
+        for i in 0..y1.len() {
+            y1[i] = y[i] + dt * v[i] + half_dt2 * a[i];
+        }
+        self.force(y1, w, h);
+    }
+    /// The end of an explicit Newmark step: v1 from
+    /// [`Self::explicit_velocity`], then the new `a` from
+    /// [`Self::acceleration`] at v1 (`a` holds the old one on entry); a
+    /// space may fuse the two passes, to the same bits.
+    fn explicit_rates(&self, dt: f64, v: &[f64], a: &mut [f64], h: &[f64], w: &mut Self::Work, v1: &mut [f64]) -> Result<(), StepFailure> {
+        self.explicit_velocity(dt, v, a, h, w, v1)?;
+        self.acceleration(v1, h, w, a);
+        Ok(())
+    }
     /// The Newmark residual r = -(M a + C v - h).
     fn residual(&self, v: &[f64], a: &[f64], h: &[f64], w: &mut Self::Work, r: &mut [f64]);
     /// Factors the Newton matrix c_m M + c_c C - dh/dy at the positions of

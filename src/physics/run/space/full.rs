@@ -15,16 +15,18 @@ use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LdltRef, LltRef, SymbolicCholesky, SymmetricOrdering};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
+use rayon::prelude::*;
 
 use super::equations::{Constants, Diagonal, Layout, Readout, Space};
 use crate::physics::error::{PhysicsError, StepFailure};
-use crate::physics::run::forces::{linearize, omega_sq_bound_full, SpringForces, SpringScratch, StiffnessPattern};
+use crate::physics::run::forces::{linearize, omega_sq_bound_full, SpringForces, SpringScratch, SpringSplit, StiffnessPattern};
 use crate::physics::run::frame::{add_outer, cross, dot, Frame, Moments};
 use crate::physics::run::state::Loads;
 use crate::physics::settings::Settings;
 use crate::physics::setup::basis;
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
+use crate::physics::vector_unit;
 
 /// The constant model of the full-space equations.
 pub struct Full {
@@ -46,7 +48,13 @@ pub struct Full {
     /// In 3D, per free node, the positions of its (x, y), (x, z), (y, z)
     /// entries in the stiffness pattern (SKIP where none).
     node_pairs: Vec<[usize; 3]>,
+    /// The threads of the spring forces and node updates when
+    /// `settings.threads` > 1 (see [`SpringForces::set_to_parallel`]).
+    pool: Option<rayon::ThreadPool>,
 }
+
+/// DOFs per task of the parallel node updates.
+const NODE_TASK: usize = 4096;
 
 /// No entry in the pattern.
 const SKIP: usize = usize::MAX;
@@ -63,6 +71,8 @@ pub struct FullWork {
     x: Vec<f64>,
     elastic: f64,
     springs: SpringScratch,
+    /// The split of the force evaluation over the threads (with a pool).
+    split: Option<SpringSplit>,
     /// C v.
     cv: Vec<f64>,
     /// Values of the matrix to factor, on the stiffness pattern.
@@ -118,7 +128,14 @@ impl Full {
         } else {
             Vec::new()
         };
+        let pool = if settings.threads > 1 {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(settings.threads).build();
+            Some(pool.map_err(|e| PhysicsError::LinearAlgebra { what: "thread pool", detail: e.to_string() })?)
+        } else {
+            None
+        };
         Ok(Full {
+            pool,
             pivot: scene.pivot(),
             node_pairs,
             springs: SpringForces::new(&scene),
@@ -196,6 +213,7 @@ impl Full {
         let stack = MemStack::new(&mut w.mem);
         let llt = self.symbolic.factorize_numeric_llt(&mut w.l_values, a, Side::Upper, LltRegularization::default(), Par::Seq, stack, Default::default());
         w.indefinite = llt.is_err();
+        vector_unit::clean();
         if !w.indefinite {
             return Ok(());
         }
@@ -206,7 +224,7 @@ impl Full {
         let regularization = LdltRegularization { dynamic_regularization_signs: None, dynamic_regularization_delta: 0.0, dynamic_regularization_epsilon: 0.0 };
         self.symbolic
             .factorize_numeric_ldlt(&mut w.l_values, a, Side::Upper, regularization, Par::Seq, stack, Default::default())
-            .map(|_| ())
+            .map(|_| vector_unit::clean())
             .map_err(|_| StepFailure::Buckled)
     }
 }
@@ -272,6 +290,30 @@ impl Full {
 /// Iterates of the Coriolis velocity update before a step is refused.
 const MAX_CORIOLIS_ITERATIONS: usize = 100;
 
+impl Full {
+    /// h = f_springs(x) + M g + f_p at the slot positions in `w` (gravity
+    /// and the springs in one pass, as adding the springs to a copy of
+    /// gravity); turning, the centrifugal force joins it.
+    fn force_at_slots(&self, w: &mut FullWork, h: &mut [f64]) {
+        w.elastic = match (&self.pool, &mut w.split) {
+            (Some(pool), Some(split)) => self.springs.set_to_parallel(&self.scene, &w.x, &mut w.springs, split, pool, &w.gravity, h),
+            _ => self.springs.set_to(&self.scene, &w.x, &mut w.springs, &w.gravity, h),
+        };
+        if w.turning {
+            let (d, spin) = (self.scene.dim, w.spin);
+            let w2 = dot(&spin, &spin);
+            for (k, hk) in h.chunks_exact_mut(d).enumerate() {
+                let m = self.scene.dof_mass[k * d];
+                let rho: [f64; 3] = std::array::from_fn(|i| if i < d { w.x[k * d + i] - self.pivot[i] } else { 0.0 });
+                let along = dot(&spin, &rho);
+                for i in 0..d {
+                    hk[i] += m * (w2 * rho[i] - spin[i] * along);
+                }
+            }
+        }
+    }
+}
+
 impl Constants for Full {
     fn scene(&self) -> &Scene {
         &self.scene
@@ -317,6 +359,7 @@ impl Space for Full {
             x: self.scene.rest.clone(),
             elastic: 0.0,
             springs: self.springs.scratch(&self.scene),
+            split: self.pool.as_ref().map(|p| self.springs.split(p.current_num_threads())),
             cv: vec![0.0; n],
             matrix: vec![0.0; self.pattern.nnz()],
             l_values: vec![0.0; self.symbolic.len_val()],
@@ -384,20 +427,56 @@ impl Space for Full {
         for k in 0..u.len() {
             w.x[k] = self.scene.rest[k] + u[k];
         }
-        h.copy_from_slice(&w.gravity);
-        w.elastic = self.springs.add_to(&self.scene, &w.x, &mut w.springs, h);
-        if w.turning {
-            let (d, spin) = (self.scene.dim, w.spin);
-            let w2 = dot(&spin, &spin);
-            for (k, hk) in h.chunks_exact_mut(d).enumerate() {
-                let m = self.scene.dof_mass[k * d];
-                let rho: [f64; 3] = std::array::from_fn(|i| if i < d { w.x[k * d + i] - self.pivot[i] } else { 0.0 });
-                let along = dot(&spin, &rho);
-                for i in 0..d {
-                    hk[i] += m * (w2 * rho[i] - spin[i] * along);
-                }
+        self.force_at_slots(w, h);
+    }
+
+    /// The predictor and x = x* + u1 in one pass, then h as [`Self::force`].
+    #[allow(clippy::too_many_arguments)]
+    fn predicted_force(&self, y: &[f64], v: &[f64], a: &[f64], dt: f64, y1: &mut [f64], w: &mut FullWork, h: &mut [f64]) {
+        let half_dt2 = 0.5 * dt * dt;
+        let rest = &self.scene.rest;
+        let update = |first: usize, y1: &mut [f64], x: &mut [f64]| {
+            for (i, (y1, x)) in y1.iter_mut().zip(x).enumerate() {
+                let k = first + i;
+                *y1 = y[k] + dt * v[k] + half_dt2 * a[k];
+                *x = rest[k] + *y1;
             }
+        };
+        let n = y1.len();
+        match &self.pool {
+            Some(pool) => pool.install(|| {
+                y1.par_chunks_mut(NODE_TASK).zip(w.x[..n].par_chunks_mut(NODE_TASK)).enumerate().for_each(|(t, (y1, x))| update(t * NODE_TASK, y1, x))
+            }),
+            None => update(0, y1, &mut w.x[..n]),
         }
+        self.force_at_slots(w, h);
+    }
+
+    /// Without stiffness-proportional damping and not turning, v1 and the
+    /// new a in one pass: v1 = (M (v + dt/2 a) + dt/2 h) / (M (1 + dt/2 alpha)),
+    /// a1 = (h - alpha M v1) / M, each DOF as the two calls compute it.
+    fn explicit_rates(&self, dt: f64, v: &[f64], a: &mut [f64], h: &[f64], w: &mut FullWork, v1: &mut [f64]) -> Result<(), StepFailure> {
+        if w.turning || w.beta != 0.0 {
+            self.explicit_velocity(dt, v, a, h, w, v1)?;
+            self.acceleration(v1, h, w, a);
+            return Ok(());
+        }
+        let (mass, alpha) = (&self.scene.dof_mass, w.alpha);
+        let update = |first: usize, v1: &mut [f64], a: &mut [f64]| {
+            for (i, (v1, a)) in v1.iter_mut().zip(a).enumerate() {
+                let (k, m) = (first + i, mass[first + i]);
+                let vk = (m * (v[k] + 0.5 * dt * *a) + 0.5 * dt * h[k]) / (m * (1.0 + 0.5 * dt * alpha));
+                *v1 = vk;
+                *a = (h[k] - alpha * m * vk) / m;
+            }
+        };
+        match &self.pool {
+            Some(pool) => {
+                pool.install(|| v1.par_chunks_mut(NODE_TASK).zip(a.par_chunks_mut(NODE_TASK)).enumerate().for_each(|(t, (v1, a))| update(t * NODE_TASK, v1, a)))
+            }
+            None => update(0, v1, a),
+        }
+        Ok(())
     }
 
     /// Turning, (M + dt/2 C + dt M [Omega]x) v1 = the same right side: the
@@ -469,6 +548,7 @@ impl Space for Full {
         } else {
             LltRef::<usize, f64>::new(&self.symbolic, &w.l_values).solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
         }
+        vector_unit::clean();
     }
 
     fn omega_sq_bound(&self, _w: &FullWork) -> f64 {

@@ -43,6 +43,7 @@ use crate::physics::setup::basis;
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
 use crate::physics::setup::setup_data::{SetupData, TrainedRange};
+use crate::physics::vector_unit;
 
 /// Above this many modes the explicit limit uses the full-space bound
 /// instead of the eigenvalues of the reduced taut stiffness.
@@ -303,6 +304,7 @@ impl<F: ReducedForce> Space for Modal<F> {
             }
             let stack = MemStack::new(&mut w.mem);
             lu_in_place(w.velocity.as_mut(), &mut w.velocity_perm, &mut w.velocity_perm_inv, Par::Seq, stack, Default::default());
+            vector_unit::clean();
             w.velocity_dt = dt;
         }
         for j in 0..r {
@@ -312,6 +314,7 @@ impl<F: ReducedForce> Space for Modal<F> {
         let lu = w.velocity.as_ref();
         let stack = MemStack::new(&mut w.mem);
         solve_in_place_with_conj(lu, lu, perm, Conj::No, MatMut::from_column_major_slice_mut(v1, r, 1), Par::Seq, stack);
+        vector_unit::clean();
         Ok(())
     }
 

@@ -12,6 +12,7 @@ use crate::physics::settings::Settings;
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
 use crate::physics::setup::setup_data::SpringSet;
+use crate::physics::vector_unit;
 
 /// How the modal space evaluates the projected spring force Phi^T f(x* + Phi q)
 /// and its tangent Phi^T K(x) Phi: every spring ([`super::Exact`]), or a model that
@@ -112,6 +113,7 @@ impl Modes {
         let r = self.basis.r;
         let dst = MatMut::from_column_major_slice_mut(&mut out[..r], r, 1);
         matmul(dst, Accum::Replace, self.phi().transpose(), MatRef::from_column_major_slice(&f[..self.basis.n], self.basis.n, 1), 1.0, Par::Seq);
+        vector_unit::clean();
     }
 
     /// Phi v for modal rates `v`, one mode at a time (as [`Self::expand`]).
