@@ -209,6 +209,7 @@ impl DirectionModel {
         let psi_t = MatRef::from_column_major_slice(&self.psi, k, n);
         let seen = MatMut::from_column_major_slice_mut(&mut self.seen, k, 1);
         matmul(seen, Accum::Replace, psi_t, MatRef::from_column_major_slice(f, n, 1), 1.0, Par::Seq);
+        crate::physics::vector_unit::clean();
         self.seen.iter().map(|z| z * z).sum()
     }
 
