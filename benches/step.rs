@@ -232,14 +232,20 @@ fn cloth_instance(n: u64, limit: f64) -> fmi3Instance {
     cloth_with(n, &[(vr::MODE_SELECTION, 2), (vr::FORCE_EVALUATION, 2)], true, limit)
 }
 
-/// An instance of the cloth-3d scene on an n x n grid with 16 modes, the
-/// enumerations `choices`, a static correction if `correction`,
-/// forceResidualLimit `limit`, every other value at its default, initialized at t = 0.
-fn cloth_with(n: u64, choices: &[(u32, i64)], correction: bool, limit: f64) -> fmi3Instance {
+/// A new Co-Simulation instance of the FMU, silent.
+fn instantiate() -> fmi3Instance {
     let (name, token) = (CString::new("bench").unwrap(), CString::new(INSTANTIATION_TOKEN).unwrap());
     let inst =
         unsafe { fmi3InstantiateCoSimulation(name.as_ptr(), token.as_ptr(), null(), false, false, false, false, null(), 0, null_mut(), Some(silent), None) };
     assert!(!inst.is_null());
+    inst
+}
+
+/// An instance of the cloth-3d scene on an n x n grid with 16 modes, the
+/// enumerations `choices`, a static correction if `correction`,
+/// forceResidualLimit `limit`, every other value at its default, initialized at t = 0.
+fn cloth_with(n: u64, choices: &[(u32, i64)], correction: bool, limit: f64) -> fmi3Instance {
+    let inst = instantiate();
     let ok = fmi3Status_fmi3OK;
     unsafe {
         for (r, v) in [(vr::NX, n), (vr::NY, n), (vr::DIMENSION, 3), (vr::N_MODES, 16), (vr::LOAD_COLUMN, n / 2)] {
@@ -422,10 +428,7 @@ fn adaptive(c: &mut Criterion) {
 /// explicit, structural and shear springs, no auxiliary springs, the
 /// residual check off, internal steps of `dt`, on `threads` threads, initialized at t = 0.
 fn full_space_instance(n: u64, dt: f64, threads: u64) -> fmi3Instance {
-    let (name, token) = (CString::new("bench").unwrap(), CString::new(INSTANTIATION_TOKEN).unwrap());
-    let inst =
-        unsafe { fmi3InstantiateCoSimulation(name.as_ptr(), token.as_ptr(), null(), false, false, false, false, null(), 0, null_mut(), Some(silent), None) };
-    assert!(!inst.is_null());
+    let inst = instantiate();
     let ok = fmi3Status_fmi3OK;
     unsafe {
         for (r, v) in [(vr::NX, n), (vr::NY, n), (vr::DIMENSION, 3), (vr::N_MODES, 1), (vr::THREADS, threads)] {
