@@ -2,7 +2,7 @@
 //! sub-stepping, snapshots.
 
 use modal_mass_spring::canonical_scenes;
-use modal_mass_spring::physics::run::forces::StiffnessPattern;
+use modal_mass_spring::physics::run::stiffness::StiffnessPattern;
 use modal_mass_spring::physics::setup::modes::ModalBasis;
 use modal_mass_spring::physics::setup::scene::Scene;
 use modal_mass_spring::physics::*;

@@ -14,8 +14,9 @@ use crate::common;
 use common::*;
 use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::fmi::variables::vr;
-use modal_mass_spring::physics::run::forces::{SpringForces, SpringScratch, StiffnessPattern};
+use modal_mass_spring::physics::run::forces::{SpringForces, SpringScratch};
 use modal_mass_spring::physics::run::frame::{apply, apply_transposed, cross, dot, rotation};
+use modal_mass_spring::physics::run::stiffness::StiffnessPattern;
 use modal_mass_spring::physics::*;
 use nalgebra::{DMatrix, DVector};
 

@@ -48,7 +48,8 @@ use faer::{Accum, Conj, MatMut, MatRef, Par};
 
 use crate::physics::error::PhysicsError;
 use crate::physics::run::error_model::{ErrorState, BETA};
-use crate::physics::run::forces::{block, pull};
+use crate::physics::run::forces::pull;
+use crate::physics::run::stiffness::block;
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
 use crate::physics::setup::setup_data::SpringSet;

@@ -47,7 +47,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 
 use crate::physics::error::PhysicsError;
-use crate::physics::run::forces::StiffnessPattern;
+use crate::physics::run::stiffness::StiffnessPattern;
 use crate::physics::vector_unit;
 
 /// e, e', e'' of the error model: the part of an adaptive run's state that

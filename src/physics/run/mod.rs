@@ -1,7 +1,8 @@
 //! The run floor: what steps the sheet and reads it, built once at set-up
 //! and then only written by the steps.
 //!
-//! - [`forces`]: exact spring forces, tangent stiffness, sparsity (the kernel);
+//! - [`forces`]: exact spring forces (the kernel);
+//! - [`stiffness`]: tangent stiffness, its sparsity and assembly;
 //! - [`space`]: where the equations M y'' + C y' = h(y) live (modal, full),
 //!   each a constant model with its own scratch;
 //! - [`integrator`]: the schemes (explicit and implicit Newmark,
@@ -25,3 +26,4 @@ pub mod integrator;
 pub mod simulator;
 pub mod space;
 pub mod state;
+pub mod stiffness;

@@ -43,9 +43,9 @@
 
 use crate::physics::error::PhysicsError;
 use crate::physics::run::error_directions::error_directions;
-use crate::physics::run::forces::StiffnessPattern;
 use crate::physics::run::space::basis_bound;
 use crate::physics::run::state::Loads;
+use crate::physics::run::stiffness::StiffnessPattern;
 use crate::physics::settings::{ForceEvaluation, Linearization, ModeSelection, Settings};
 use crate::physics::setup::basis;
 use crate::physics::setup::cubature_training;

@@ -25,9 +25,9 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Accum, Col, Mat, MatMut, MatRef, Par, Side};
 
 use crate::physics::error::PhysicsError;
-use crate::physics::run::forces::StiffnessPattern;
 use crate::physics::run::frame::cross;
 use crate::physics::run::state::Loads;
+use crate::physics::run::stiffness::StiffnessPattern;
 use crate::physics::settings::{Linearization, ModeSelection, Settings};
 use crate::physics::setup::equilibrium::equilibrium;
 use crate::physics::setup::modes::ModalBasis;
@@ -217,7 +217,7 @@ pub fn constraint_vectors(
 /// starts when a holder is set away from its rest place before it starts.
 pub fn static_response(scene: &Scene, x: &[f64]) -> Result<Vec<f64>, PhysicsError> {
     let d = scene.dim;
-    let (pattern, stiffness) = crate::physics::run::forces::linearize(scene);
+    let (pattern, stiffness) = crate::physics::run::stiffness::linearize(scene);
     let f = held_pull(scene, &scene.rest, |slot| std::array::from_fn(|c| if c < d { x[slot * d + c] - scene.rest[slot * d + c] } else { 0.0 }));
     Ok(ShiftedStiffness::new(scene, &pattern, &stiffness)?.solve(&f))
 }

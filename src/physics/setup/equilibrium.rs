@@ -27,7 +27,8 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::Side;
 
 use crate::physics::error::PhysicsError;
-use crate::physics::run::forces::{SpringForces, StiffnessPattern};
+use crate::physics::run::forces::SpringForces;
+use crate::physics::run::stiffness::StiffnessPattern;
 use crate::physics::setup::scene::Scene;
 
 /// Newton iterations in all, over every load increment: a buckling cloth

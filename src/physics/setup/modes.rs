@@ -18,7 +18,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Col, Mat, MatMut, MatRef, Par, Side};
 
 use crate::physics::error::PhysicsError;
-use crate::physics::run::forces::StiffnessPattern;
+use crate::physics::run::stiffness::StiffnessPattern;
 use crate::physics::setup::scene::Scene;
 
 /// Largest dense eigenproblem attempted (free DOFs): its matrix alone takes

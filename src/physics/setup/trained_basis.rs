@@ -31,12 +31,12 @@
 use faer::Mat;
 
 use crate::physics::error::{Expected, PhysicsError, Quantity};
-use crate::physics::run::forces::StiffnessPattern;
 use crate::physics::run::frame::{apply, cross, dot, norm, rotation, Frame};
 use crate::physics::run::holders::{self, Placement};
 use crate::physics::run::integrator::{Buffers, NewmarkExplicit, Scheme};
 use crate::physics::run::space::{basis_bound, Full, Space};
 use crate::physics::run::state::{Loads, State};
+use crate::physics::run::stiffness::StiffnessPattern;
 use crate::physics::settings::{ForceEvaluation, Linearization, Reduction, Settings, TrainingProgram};
 use crate::physics::setup::basis::{self, load_patterns};
 use crate::physics::setup::cubature_training;

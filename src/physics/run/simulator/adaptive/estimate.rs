@@ -4,6 +4,7 @@
 use super::unseen::unseen_share_sq;
 use super::{slot_motion, Adaptive};
 use crate::physics::error::PhysicsError;
+use crate::physics::run::error_directions::DirectionModel;
 use crate::physics::run::error_model::ErrorState;
 use crate::physics::run::integrator::Scheme;
 use crate::physics::run::simulator::estimators::Estimator;
@@ -153,8 +154,9 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
 
     /// On a return to `basis`: the error carried plus the part of the state
     /// the basis leaves out (`left`, `left_rate` over the free DOFs) become
-    /// the error model's state beside it.
-    pub(super) fn carry_error(&mut self, basis: &ModalBasis, left: &[f64], left_rate: &[f64]) {
+    /// the error model's state beside it; `built`, the direction model of
+    /// `basis` where the return made it already (it is one pass over every spring).
+    pub(super) fn carry_error(&mut self, basis: &ModalBasis, built: Option<DirectionModel>, left: &[f64], left_rate: &[f64]) {
         match &mut self.model {
             Estimator::Full(_) => {
                 self.error.e.iter_mut().zip(left).for_each(|(e, l)| *e += l);
@@ -165,8 +167,10 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
                 let (mut e, mut v) = old.error_of(&self.error);
                 e.iter_mut().zip(left).for_each(|(e, l)| *e += l);
                 v.iter_mut().zip(left_rate).for_each(|(e, l)| *e += l);
-                let set = self.chosen.choice.error_set.as_ref().expect("a direction model has a spring set");
-                let model = Estimator::directions(self.full.space.scene(), &self.chosen, basis, set);
+                let model = built.unwrap_or_else(|| {
+                    let set = self.chosen.choice.error_set.as_ref().expect("a direction model has a spring set");
+                    Estimator::directions(self.full.space.scene(), &self.chosen, basis, set)
+                });
                 self.error = ErrorState::zero(model.directions());
                 model.add(&mut self.error, &e, &v);
                 self.model = Estimator::Directions(model);

@@ -39,7 +39,8 @@
 
 use super::reduced::{ForceSetup, Modes, ReducedForce};
 use crate::physics::error::PhysicsError;
-use crate::physics::run::forces::{add_projected_block, block, pull, SpringForces, SpringScratch};
+use crate::physics::run::forces::{pull, SpringForces, SpringScratch};
+use crate::physics::run::stiffness::{add_projected_block, block};
 use crate::physics::setup::scene::Scene;
 use crate::physics::setup::setup_data::SpringSet;
 

@@ -5,7 +5,8 @@
 
 use super::reduced::{ForceSetup, Modes, ReducedForce};
 use crate::physics::error::PhysicsError;
-use crate::physics::run::forces::{add_reduced_tangent, SpringForces, SpringScratch};
+use crate::physics::run::forces::{SpringForces, SpringScratch};
+use crate::physics::run::stiffness::add_reduced_tangent;
 use crate::physics::setup::scene::Scene;
 
 /// Every spring, exactly.

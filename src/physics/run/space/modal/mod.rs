@@ -35,9 +35,9 @@ pub use work::ModalWork;
 
 use super::equations::{Constants, Diagonal, Layout, Readout, Space};
 use crate::physics::error::{PhysicsError, StepFailure};
-use crate::physics::run::forces::omega_sq_bound_full;
 use crate::physics::run::frame::{dot, Frame, Moments};
 use crate::physics::run::state::Loads;
+use crate::physics::run::stiffness::omega_sq_bound_full;
 use crate::physics::settings::Settings;
 use crate::physics::setup::basis;
 use crate::physics::setup::modes::ModalBasis;

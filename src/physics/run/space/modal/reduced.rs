@@ -6,8 +6,8 @@ use faer::linalg::matmul::matmul;
 use faer::{Accum, MatMut, MatRef, Par, Side};
 
 use crate::physics::error::PhysicsError;
-use crate::physics::run::forces::add_reduced_tangent;
 use crate::physics::run::state::Loads;
+use crate::physics::run::stiffness::add_reduced_tangent;
 use crate::physics::settings::Settings;
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;

@@ -1,0 +1,115 @@
+//! The return from full space: the basis grown from the stretch (or the
+//! chosen one, with cubature forces), tested against the stretch's poses,
+//! the state's velocity and the residual the error directions see; the
+//! reduced run resumed at q = Φᵀ M (x − x*), q' = Φᵀ M v.
+
+use super::runs::reduced_run;
+use super::unseen::unseen_share_sq;
+use super::{Adaptive, LONGEST_STRETCH};
+use crate::physics::error::PhysicsError;
+use crate::physics::run::integrator::Scheme;
+use crate::physics::run::simulator::estimators::Estimator;
+use crate::physics::run::simulator::Run;
+use crate::physics::run::space::{Constants, Modal, ReducedForce};
+use crate::physics::run::state::Loads;
+use crate::physics::setup::adaptive_basis::{self, CAP_FACTOR, GROWTH, PROJECTION_SHARE};
+
+impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
+    /// Grows the basis from the stretch and returns to it if it holds the
+    /// state; else the next stretch is twice as long (see the module documentation).
+    pub(super) fn try_return(&mut self) -> Result<(), PhysicsError> {
+        if !self.reduces || self.outside_program() {
+            self.stretch = 0;
+            return Ok(());
+        }
+        let scene = self.full.space.scene().clone();
+        let size = self.chosen.data.basis.r;
+        let count = ((GROWTH * size as f64).ceil() as usize).max(1);
+        // With cubature forces the basis does not grow: the spring set is
+        // trained for the chosen basis and its error directions, and on a
+        // grown basis the reduced run leaves the physics within a few steps
+        // (cloth 100 x 100: the force residual 6.6 times the load five steps after a return).
+        let cubature = self.chosen.choice.error_set.is_some();
+        let (grown, mut reduced) = if cubature {
+            (Vec::new(), reduced_run(&scene, &self.chosen.settings, &self.loads, &self.chosen.data)?)
+        } else {
+            let current = self.reduced.space.basis().clone();
+            let new = adaptive_basis::new_directions(&scene, &current, self.seen(), count)?;
+            let mut grown = self.grown.clone();
+            grown.extend(new);
+            let cap = (CAP_FACTOR * size).min(scene.n_dofs());
+            while self.chosen.trained.len() + grown.len() > cap && !grown.is_empty() {
+                grown.remove(0);
+            }
+            let run = self.grown_run(&grown, &self.loads)?;
+            (grown, run)
+        };
+        let basis = reduced.space.basis().clone();
+        // The grown basis must hold the state and the stretch's poses.
+        let motion = self.motion_sq().max(self.chosen.choice.motion_scale.powi(2));
+        let limit = (PROJECTION_SHARE * self.settings.error_tolerance).powi(2) * motion;
+        let left = |s: &[f64]| -> f64 {
+            let mut q = vec![0.0; basis.r];
+            basis.project_displacement(&scene.dof_mass, s, &mut q);
+            (0..s.len())
+                .map(|i| scene.dof_mass[i] * (s[i] - basis.phi[i * basis.r..(i + 1) * basis.r].iter().zip(&q).map(|(p, q)| p * q).sum::<f64>()).powi(2))
+                .sum()
+        };
+        // And the state's velocity, to the same share of its own size.
+        let v = &self.full.state.v;
+        let speed: f64 = (0..v.len()).map(|i| scene.dof_mass[i] * v[i] * v[i]).sum();
+        let holds_velocity = left(v) <= (PROJECTION_SHARE * self.settings.error_tolerance).powi(2) * speed;
+        if !holds_velocity || !self.seen().iter().all(|s| left(s) <= limit) {
+            self.stretch = 0;
+            self.stretch_target = (2 * self.stretch_target).min(LONGEST_STRETCH);
+            return Ok(());
+        }
+        // q = Φᵀ M (x − x*), q' = Φᵀ M v; what the basis leaves out is the return's error.
+        let pose = self.pose();
+        let (mass, r) = (&scene.dof_mass, basis.r);
+        let mut s = reduced.state.clone();
+        basis.project_displacement(mass, &pose, &mut s.y);
+        basis.project_displacement(mass, &self.full.state.v, &mut s.v);
+        s.copy_frame_from(&self.full.state);
+        let (mut left, mut left_rate) = (pose.clone(), self.full.state.v.clone());
+        for (i, (l, lr)) in left.iter_mut().zip(&mut left_rate).enumerate() {
+            let row = &basis.phi[i * r..(i + 1) * r];
+            *l -= row.iter().zip(&s.y).map(|(p, q)| p * q).sum::<f64>();
+            *lr -= row.iter().zip(&s.v).map(|(p, q)| p * q).sum::<f64>();
+        }
+        reduced.resume(&s, true);
+        // And the residual there must be one the error directions beside it see.
+        let mut built = None;
+        if let Some(set) = &self.chosen.choice.error_set {
+            let mut model = Estimator::directions(&scene, &self.chosen, &basis, set);
+            let u = unseen_share_sq(&mut reduced, &mut model, &mut self.residual);
+            if u > self.unseen_limit_sq() {
+                self.stretch = 0;
+                self.stretch_target = (2 * self.stretch_target).min(LONGEST_STRETCH);
+                return Ok(());
+            }
+            built = Some(model);
+        }
+        self.carry_error(&basis, built, &left, &left_rate);
+        self.rewind = s;
+        self.reduced = reduced;
+        self.kick_q = vec![0.0; self.reduced.space.basis().r];
+        self.grown = grown;
+        self.set_motion_reference();
+        self.in_full = false;
+        self.stretch = 0;
+        self.estimate_soon();
+        self.report_basis();
+        Ok(())
+    }
+}
+
+impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
+    /// The modal run on the trained vectors and `grown` under `loads`.
+    pub(super) fn grown_run(&self, grown: &[Vec<f64>], loads: &Loads) -> Result<Run<Modal<F>, R>, PhysicsError> {
+        let scene = self.full.space.scene();
+        let vectors: Vec<Vec<f64>> = self.chosen.trained.iter().chain(grown).cloned().collect();
+        let data = adaptive_basis::grown_setup(scene, &self.chosen, &vectors)?;
+        reduced_run(scene, &self.chosen.settings, loads, &data)
+    }
+}
