@@ -1,4 +1,4 @@
-//! `cargo xtask setup [--for run|sweep|test]`: installs what a task needs,
+//! `cargo xtask setup [--for run|sweep|view|test]`: installs what a task needs,
 //! and only what is missing, so it is cheap to run again.
 //!
 //! - Debian packages, through apt-get (`apt-get update` once, only when
@@ -18,6 +18,9 @@
 //!   masters `tests/python/test_chain.py` runs the FMU under) and ecospy
 //!   (the Ecos co-simulation engine, `tests/python/test_ecos.py`); ruff,
 //!   the Python linter of the `lint` stage (xtask/src/lint.rs).
+//! - For the live view, its page's three.js and lil-gui from the npm
+//!   registry into target/view-assets/ (python/viewing/assets.py: pinned
+//!   versions checked against their sha512s).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -66,8 +69,7 @@ const PYTHON_PACKAGES: &[(&str, &str, Purpose)] = &[
     ("matplotlib", "matplotlib", Purpose::Run),
     ("distributed", "dask[distributed]==2026.8.0", Purpose::Sweep),
     // the live view's server (static files and websockets on one port); its
-    // page's three.js and lil-gui come from the npm registry on first use
-    // (python/viewing/assets.py, checked against pinned sha512s)
+    // page's three.js and lil-gui come from the npm registry (page_assets)
     ("aiohttp", "aiohttp==3.14.5", Purpose::View),
     ("selenium", "selenium==4.51.0", Purpose::Test),
     ("pytest", "pytest", Purpose::Test),
@@ -149,7 +151,28 @@ pub fn install(purpose: Purpose) -> Result<(), String> {
     debian_packages(purpose)?;
     venv()?;
     python_packages(purpose)?;
+    if purpose >= Purpose::View {
+        page_assets()?;
+    }
     Ok(())
+}
+
+/// The live view's page libraries, three.js and lil-gui, from the npm
+/// registry into target/view-assets/ (python/viewing/assets.py: pinned
+/// versions, each tarball checked against its pinned sha512; nothing done
+/// when they are there).
+fn page_assets() -> Result<(), String> {
+    let status = Command::new(python())
+        .current_dir(root())
+        .args(["python/viewing/assets.py"])
+        .stdout(Stdio::null())
+        .status()
+        .map_err(|e| format!("cannot run python/viewing/assets.py: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("the live view's page libraries could not be fetched ({status}); see above"))
+    }
 }
 
 fn wanted<T: Copy>(list: &[(T, Purpose)], purpose: Purpose) -> Vec<T> {

@@ -143,7 +143,9 @@ function build() {
   const objects = [];
   const big = n > LINE_NODES;
   if (big) {
-    objects.push(new THREE.Mesh(surface(attribute), new THREE.MeshLambertMaterial({ color: COLOURS.sheet, side: THREE.DoubleSide })));
+    // Flat shading: each cell's normal from the screen-space derivatives of its
+    // position in the fragment shader, so no per-frame vertex normals in the script.
+    objects.push(new THREE.Mesh(surface(attribute), new THREE.MeshLambertMaterial({ color: COLOURS.sheet, side: THREE.DoubleSide, flatShading: true })));
   } else {
     const g = new THREE.BufferGeometry();
     g.setAttribute("position", attribute);
@@ -198,7 +200,6 @@ function draw() {
     latest = null;
     drawn.attribute.array.set(x);
     drawn.attribute.needsUpdate = true;
-    if (drawn.big) drawn.objects[0].geometry.computeVertexNormals();
     if (!pulling) loadHandle.object.position.fromArray(x, 3 * inst.loadNode);
     view.positions = x;
   }

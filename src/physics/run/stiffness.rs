@@ -5,9 +5,12 @@
 //! Like the force kernels of [`crate::physics::run::forces`], every loop
 //! walks the spring list once and is monomorphised on the dimension `D`.
 
+use faer::linalg::matmul::matmul;
+use faer::{Accum, MatMut, MatRef, Par};
 use nalgebra::{SMatrix, SVector};
 
 use crate::physics::setup::scene::{Scene, Spring};
+use crate::physics::vector_unit;
 
 /// Tangent stiffness block of one spring with vector d, K_e = k [ u u^T + (1 - l0/l)(I - u u^T) ],
 /// u = d / l (`docs/method.md`, section 2).
@@ -56,6 +59,39 @@ fn reduced_tangent<const D: usize>(scene: &Scene, x: &[f64], phi: &[f64], r: usi
         }
         add_projected_block::<D>(&ke, g, r, kg, kr);
     }
+}
+
+/// The reduced taut stiffness Phi^T K_taut Phi (r x r, column-major) into
+/// `kr`, K_taut the stiffness with every spring as k I (state-independent):
+/// K_taut Phi a spring at a time (3 D r operations each: k (Phi_a - Phi_b)
+/// to row a, its negative to row b), then Phi^T (K_taut Phi) by faer's
+/// product. The same matrix as [`add_reduced_tangent`] with `taut`, in
+/// D r instead of D r^2 operations per spring (on cloth 30 x 30 with 62
+/// vectors about 40x faster); its round-off differs.
+pub fn reduced_taut_stiffness(scene: &Scene, phi: &[f64], r: usize, kr: &mut [f64]) {
+    let (d, n_free) = (scene.dim, scene.n_free);
+    let n = n_free * d;
+    let mut k_phi = vec![0.0; n * r];
+    let mut g = vec![0.0; r];
+    for s in &scene.springs {
+        for i in 0..d {
+            for (j, gj) in g.iter_mut().enumerate() {
+                let pa = if s.a < n_free { phi[(s.a * d + i) * r + j] } else { 0.0 };
+                let pb = if s.b < n_free { phi[(s.b * d + i) * r + j] } else { 0.0 };
+                *gj = s.k * (pa - pb);
+            }
+            if s.a < n_free {
+                k_phi[(s.a * d + i) * r..(s.a * d + i + 1) * r].iter_mut().zip(&g).for_each(|(o, g)| *o += g);
+            }
+            if s.b < n_free {
+                k_phi[(s.b * d + i) * r..(s.b * d + i + 1) * r].iter_mut().zip(&g).for_each(|(o, g)| *o -= g);
+            }
+        }
+    }
+    let phi = MatRef::from_row_major_slice(&phi[..n * r], n, r);
+    let k_phi = MatRef::from_row_major_slice(&k_phi, n, r);
+    matmul(MatMut::from_column_major_slice_mut(&mut kr[..r * r], r, r), Accum::Replace, phi.transpose(), k_phi, 1.0, Par::Seq);
+    vector_unit::clean();
 }
 
 /// kr += G^T K_e G for one spring's block K_e (D x D) and G = Phi_a - Phi_b

@@ -32,6 +32,7 @@ use crate::physics::settings::{Linearization, ModeSelection, Settings};
 use crate::physics::setup::equilibrium::equilibrium;
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
+use crate::physics::vector_unit;
 
 /// Scenes up to this many free DOFs rank every mode (a dense decomposition);
 /// larger ones rank load-dependent Ritz pairs.
@@ -446,6 +447,33 @@ impl<'a> MOrthonormal<'a> {
         self.k += 1;
         Some(self.q.col(k).try_as_col_major().expect("contiguous").as_slice())
     }
+}
+
+/// The first independent directions of `vectors` (in their order),
+/// M-orthonormalized as [`orthonormal_ritz`] takes them (n x k, k at most
+/// `r`): their span, without the stiffness products and the eigen
+/// decomposition that make it a basis.
+pub fn m_orthonormal_span(mass: &[f64], vectors: &[Vec<f64>], r: usize) -> Mat<f64> {
+    let mut q = MOrthonormal::new(mass, r.min(vectors.len()));
+    for v in vectors {
+        if q.full() {
+            break;
+        }
+        q.push(v);
+    }
+    q.columns().to_owned()
+}
+
+/// ‖s − Q Qᵀ M s‖²_M = ‖s‖²_M − |Qᵀ M s|² for M-orthonormal columns `q`:
+/// what of `s` their span leaves out (faer's product; the difference of two
+/// sums, so accurate to round-off of ‖s‖²_M).
+pub fn left_out_sq(mass: &[f64], q: MatRef<'_, f64>, s: &[f64]) -> f64 {
+    let ms = Col::<f64>::from_fn(s.len(), |i| mass[i] * s[i]);
+    let mut c = Col::<f64>::zeros(q.ncols());
+    matmul(c.as_mat_mut(), Accum::Replace, q.transpose(), ms.as_mat(), 1.0, Par::Seq);
+    vector_unit::clean();
+    let all: f64 = s.iter().zip(ms.iter()).map(|(a, b)| a * b).sum();
+    (all - c.iter().map(|x| x * x).sum::<f64>()).max(0.0)
 }
 
 /// The first `r` independent directions of `vectors` (in their order),

@@ -13,6 +13,8 @@ use crate::physics::run::simulator::Run;
 use crate::physics::run::space::{Constants, Modal, ReducedForce};
 use crate::physics::run::state::Loads;
 use crate::physics::setup::adaptive_basis::{self, CAP_FACTOR, GROWTH, PROJECTION_SHARE};
+use crate::physics::setup::basis;
+use crate::physics::setup::modes::ModalBasis;
 
 impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// Grows the basis from the stretch and returns to it if it holds the
@@ -30,8 +32,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         // grown basis the reduced run leaves the physics within a few steps
         // (cloth 100 x 100: the force residual 6.6 times the load five steps after a return).
         let cubature = self.chosen.choice.error_set.is_some();
-        let (grown, mut reduced) = if cubature {
-            (Vec::new(), reduced_run(&scene, &self.chosen.settings, &self.loads, &self.chosen.data)?)
+        let grown = if cubature {
+            Vec::new()
         } else {
             let current = self.reduced.space.basis().clone();
             let new = adaptive_basis::new_directions(&scene, &current, self.seen(), count)?;
@@ -41,32 +43,46 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             while self.chosen.trained.len() + grown.len() > cap && !grown.is_empty() {
                 grown.remove(0);
             }
-            let run = self.grown_run(&grown, &self.loads)?;
-            (grown, run)
+            grown
         };
-        let basis = reduced.space.basis().clone();
-        // The grown basis must hold the state and the stretch's poses.
+        // The basis must hold the stretch's poses and the state's velocity
+        // (each to the projection share of the tolerance, of the motion and
+        // of the velocity's own size). Tested first on the span alone (the
+        // chosen basis, or the M-orthonormalized vectors), which is cheap
+        // against making a basis and a run of it; a span that fails by more
+        // than round-off (SPAN_SLACK) fails. Then again on the basis made.
+        let mass = &scene.dof_mass;
         let motion = self.motion_sq().max(self.chosen.choice.motion_scale.powi(2));
-        let limit = (PROJECTION_SHARE * self.settings.error_tolerance).powi(2) * motion;
-        let left = |s: &[f64]| -> f64 {
-            let mut q = vec![0.0; basis.r];
-            basis.project_displacement(&scene.dof_mass, s, &mut q);
-            (0..s.len())
-                .map(|i| scene.dof_mass[i] * (s[i] - basis.phi[i * basis.r..(i + 1) * basis.r].iter().zip(&q).map(|(p, q)| p * q).sum::<f64>()).powi(2))
-                .sum()
-        };
-        // And the state's velocity, to the same share of its own size.
+        let share_sq = (PROJECTION_SHARE * self.settings.error_tolerance).powi(2);
         let v = &self.full.state.v;
-        let speed: f64 = (0..v.len()).map(|i| scene.dof_mass[i] * v[i] * v[i]).sum();
-        let holds_velocity = left(v) <= (PROJECTION_SHARE * self.settings.error_tolerance).powi(2) * speed;
-        if !holds_velocity || !self.seen().iter().all(|s| left(s) <= limit) {
+        let speed: f64 = (0..v.len()).map(|i| mass[i] * v[i] * v[i]).sum();
+        let holds = |left: &dyn Fn(&[f64]) -> f64, slack: f64| -> bool {
+            left(v) <= slack * share_sq * speed && self.seen().iter().all(|s| left(s) <= slack * share_sq * motion)
+        };
+        let span_holds = if cubature {
+            let basis = &self.chosen.data.basis;
+            holds(&|s| basis_left_out_sq(basis, mass, s), SPAN_SLACK)
+        } else {
+            let vectors: Vec<Vec<f64>> = self.chosen.trained.iter().chain(&grown).cloned().collect();
+            let span = basis::m_orthonormal_span(mass, &vectors, vectors.len());
+            holds(&|s| basis::left_out_sq(mass, span.as_ref(), s), SPAN_SLACK)
+        };
+        if !span_holds {
+            self.stretch = 0;
+            self.stretch_target = (2 * self.stretch_target).min(LONGEST_STRETCH);
+            return Ok(());
+        }
+        let mut reduced =
+            if cubature { reduced_run(&scene, &self.chosen.settings, &self.loads, &self.chosen.data)? } else { self.grown_run(&grown, &self.loads)? };
+        let basis = reduced.space.basis().clone();
+        if !holds(&|s| basis_left_out_sq(&basis, mass, s), 1.0) {
             self.stretch = 0;
             self.stretch_target = (2 * self.stretch_target).min(LONGEST_STRETCH);
             return Ok(());
         }
         // q = Φᵀ M (x − x*), q' = Φᵀ M v; what the basis leaves out is the return's error.
         let pose = self.pose();
-        let (mass, r) = (&scene.dof_mass, basis.r);
+        let r = basis.r;
         let mut s = reduced.state.clone();
         basis.project_displacement(mass, &pose, &mut s.y);
         basis.project_displacement(mass, &self.full.state.v, &mut s.v);
@@ -112,4 +128,16 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         let data = adaptive_basis::grown_setup(scene, &self.chosen, &vectors)?;
         reduced_run(scene, &self.chosen.settings, loads, &data)
     }
+}
+
+/// A span fails the return's test before a basis is made of it only where
+/// what it leaves out passes the limit by this factor: the two ways of
+/// computing it differ by round-off, and the basis made decides.
+const SPAN_SLACK: f64 = 1.01;
+
+/// ‖s − Φ Φᵀ M s‖²_M for the M-orthonormal `basis`, as the return has always measured it.
+fn basis_left_out_sq(basis: &ModalBasis, mass: &[f64], s: &[f64]) -> f64 {
+    let mut q = vec![0.0; basis.r];
+    basis.project_displacement(mass, s, &mut q);
+    (0..s.len()).map(|i| mass[i] * (s[i] - basis.phi[i * basis.r..(i + 1) * basis.r].iter().zip(&q).map(|(p, q)| p * q).sum::<f64>()).powi(2)).sum()
 }

@@ -7,7 +7,7 @@ use faer::{Accum, MatMut, MatRef, Par, Side};
 
 use crate::physics::error::PhysicsError;
 use crate::physics::run::state::Loads;
-use crate::physics::run::stiffness::add_reduced_tangent;
+use crate::physics::run::stiffness::reduced_taut_stiffness;
 use crate::physics::settings::Settings;
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
@@ -132,8 +132,7 @@ impl Modes {
 pub fn taut_reduced_bound(scene: &Scene, basis: &ModalBasis) -> Result<f64, PhysicsError> {
     let r = basis.r;
     let mut kr = vec![0.0; r * r];
-    let mut work = vec![0.0; 6 * r];
-    add_reduced_tangent(scene, &scene.rest, &basis.phi, r, true, &mut kr, &mut work);
+    reduced_taut_stiffness(scene, &basis.phi, r, &mut kr);
     let m = faer::Mat::<f64>::from_fn(r, r, |i, j| kr[j * r + i]);
     let ev = m
         .self_adjoint_eigenvalues(Side::Lower)

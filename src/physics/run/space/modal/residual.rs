@@ -11,19 +11,15 @@ impl<F: ReducedForce> Modal<F> {
     /// the error model ([`crate::physics::run::error_model`]). One pass over
     /// every spring and 2 n r operations.
     pub fn residual_force(&self, gravity: &[f64; 3], point: &[f64; 3], q: &[f64], w: &mut ModalWork<F::Work>, out: &mut [f64]) {
-        let r = self.modes.basis.r;
         let mass = &self.scene.dof_mass;
         self.full_force(gravity, point, q, w, out);
-        let phi = &self.modes.basis.phi;
+        // F = Phi^T f (faer's product), then f -= M Phi F a column at a time.
         let big_f = &mut w.generalized_scratch;
-        big_f.fill(0.0);
-        for (k, &fk) in out.iter().enumerate() {
-            for (fj, p) in big_f.iter_mut().zip(&phi[k * r..(k + 1) * r]) {
-                *fj += p * fk;
+        self.modes.project(out, big_f);
+        for (col, fj) in self.modes.cols.chunks_exact(self.modes.basis.n).zip(big_f.iter()) {
+            for ((o, p), m) in out.iter_mut().zip(col).zip(mass) {
+                *o -= m * p * fj;
             }
-        }
-        for (k, o) in out.iter_mut().enumerate() {
-            *o -= mass[k] * phi[k * r..(k + 1) * r].iter().zip(big_f.iter()).map(|(p, f)| p * f).sum::<f64>();
         }
     }
 }
