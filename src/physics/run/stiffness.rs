@@ -121,10 +121,20 @@ pub struct StiffnessPattern {
     pub row_idx: Vec<usize>,
     /// Position of each diagonal entry.
     pub diag: Vec<usize>,
-    /// Per spring, `(2D)^2` positions of the local matrix [[Ke, -Ke], [-Ke, Ke]]
-    /// in row-major local order; `usize::MAX` where the entry is not stored
-    /// (a fixed end or the lower triangle).
+    /// Per spring, the positions of its entries of the upper triangle, in
+    /// the order of [`upper_entries`]: the D(D+1)/2 of K_e at (a, a), the
+    /// same at (b, b), the D^2 of -K_e between a and b; `usize::MAX` where
+    /// an end is held.
     local: Vec<usize>,
+}
+
+/// The entries of one spring's local matrix [[Ke, -Ke], [-Ke, Ke]] in the
+/// upper triangle, in the order `local` holds their positions: (block, i,
+/// j) with block 0 = (a, a) and 1 = (b, b) for i <= j, 2 = between a and b
+/// for every i, j. Each global entry a spring touches is one of them, once.
+fn upper_entries<const D: usize>() -> impl Iterator<Item = (usize, usize, usize)> {
+    let diagonal = move |block| (0..D).flat_map(move |i| (i..D).map(move |j| (block, i, j)));
+    diagonal(0).chain(diagonal(1)).chain((0..D).flat_map(|i| (0..D).map(move |j| (2, i, j))))
 }
 
 const SKIP: usize = usize::MAX;
@@ -164,16 +174,22 @@ impl StiffnessPattern {
         }
         let find = |r: usize, c: usize| col_ptr[c] + row_idx[col_ptr[c]..col_ptr[c + 1]].binary_search(&r).unwrap();
         let diag = (0..n).map(|c| find(c, c)).collect();
-        let mut local = Vec::with_capacity(scene.springs.len() * 4 * d * d);
+        let entries: Vec<(usize, usize, usize)> = if d == 2 { upper_entries::<2>().collect() } else { upper_entries::<3>().collect() };
+        let mut local = Vec::with_capacity(scene.springs.len() * entries.len());
         for s in &scene.springs {
-            let g = globals(s);
-            for p in 0..2 * d {
-                for q in 0..2 * d {
-                    local.push(match (g[p], g[q]) {
-                        (Some(r), Some(c)) if r <= c => find(r, c),
-                        _ => SKIP,
-                    });
-                }
+            let free = |slot: usize| slot < scene.n_free;
+            for &(block, i, j) in &entries {
+                let (p, q) = match block {
+                    0 => (s.a, s.a),
+                    1 => (s.b, s.b),
+                    _ => (s.a, s.b),
+                };
+                local.push(if free(p) && free(q) {
+                    let (r, c) = (p * d + i, q * d + j);
+                    find(r.min(c), r.max(c))
+                } else {
+                    SKIP
+                });
             }
         }
         StiffnessPattern { col_ptr, row_idx, diag, local }
@@ -199,8 +215,9 @@ impl StiffnessPattern {
     }
 
     fn add_tangent_d<const D: usize>(&self, scene: &Scene, x: &[f64], scale: f64, tension_only: bool, vals: &mut [f64]) {
-        let m = 2 * D;
-        for (si, s) in scene.springs.iter().enumerate() {
+        // `local` in the order of `upper_entries`: (a, a), (b, b), then between a and b.
+        let nd = D * (D + 1) / 2;
+        for (s, local) in scene.springs.iter().zip(self.local.chunks_exact(2 * nd + D * D)) {
             let ke = if tension_only {
                 let d: [f64; D] = std::array::from_fn(|i| x[s.b * D + i] - x[s.a * D + i]);
                 let l = d.iter().map(|c| c * c).sum::<f64>().sqrt();
@@ -208,13 +225,25 @@ impl StiffnessPattern {
             } else {
                 spring_block::<D>(s, x, false)
             };
-            let local = &self.local[si * m * m..(si + 1) * m * m];
-            for p in 0..m {
-                for q in 0..m {
-                    let pos = local[p * m + q];
+            let (aa, rest) = local.split_at(nd);
+            let (bb, ab) = rest.split_at(nd);
+            let mut k = 0;
+            for i in 0..D {
+                for j in i..D {
+                    let v = scale * ke[(i, j)];
+                    for pos in [aa[k], bb[k]] {
+                        if pos != SKIP {
+                            vals[pos] += v;
+                        }
+                    }
+                    k += 1;
+                }
+            }
+            for i in 0..D {
+                for j in 0..D {
+                    let pos = ab[i * D + j];
                     if pos != SKIP {
-                        let sign = if (p < D) == (q < D) { scale } else { -scale };
-                        vals[pos] += sign * ke[(p % D, q % D)];
+                        vals[pos] += -scale * ke[(i, j)];
                     }
                 }
             }
