@@ -47,10 +47,11 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         };
         // The basis must hold the stretch's poses and the state's velocity
         // (each to the projection share of the tolerance, of the motion and
-        // of the velocity's own size). Tested first on the span alone (the
-        // chosen basis, or the M-orthonormalized vectors), which is cheap
-        // against making a basis and a run of it; a span that fails by more
-        // than round-off (SPAN_SLACK) fails. Then again on the basis made.
+        // of the velocity's own size). With cubature forces the basis is the
+        // chosen one, tested before its run is made; a grown basis is tested
+        // first on its span alone (the M-orthonormalized vectors), which is
+        // cheap against making a basis and a run of it, failing only by more
+        // than round-off (SPAN_SLACK), then on the basis made.
         let mass = &scene.dof_mass;
         let motion = self.motion_sq().max(self.chosen.choice.motion_scale.powi(2));
         let share_sq = (PROJECTION_SHARE * self.settings.error_tolerance).powi(2);
@@ -61,23 +62,21 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         };
         let span_holds = if cubature {
             let basis = &self.chosen.data.basis;
-            holds(&|s| basis_left_out_sq(basis, mass, s), SPAN_SLACK)
+            holds(&|s| basis_left_out_sq(basis, mass, s), 1.0)
         } else {
             let vectors: Vec<Vec<f64>> = self.chosen.trained.iter().chain(&grown).cloned().collect();
             let span = basis::m_orthonormal_span(mass, &vectors, vectors.len());
             holds(&|s| basis::left_out_sq(mass, span.as_ref(), s), SPAN_SLACK)
         };
         if !span_holds {
-            self.stretch = 0;
-            self.stretch_target = (2 * self.stretch_target).min(LONGEST_STRETCH);
+            self.failed_return();
             return Ok(());
         }
         let mut reduced =
             if cubature { reduced_run(&scene, &self.chosen.settings, &self.loads, &self.chosen.data)? } else { self.grown_run(&grown, &self.loads)? };
         let basis = reduced.space.basis().clone();
-        if !holds(&|s| basis_left_out_sq(&basis, mass, s), 1.0) {
-            self.stretch = 0;
-            self.stretch_target = (2 * self.stretch_target).min(LONGEST_STRETCH);
+        if !cubature && !holds(&|s| basis_left_out_sq(&basis, mass, s), 1.0) {
+            self.failed_return();
             return Ok(());
         }
         // q = Φᵀ M (x − x*), q' = Φᵀ M v; what the basis leaves out is the return's error.
@@ -100,8 +99,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             let mut model = Estimator::directions(&scene, &self.chosen, &basis, set);
             let u = unseen_share_sq(&mut reduced, &mut model, &mut self.residual);
             if u > self.unseen_limit_sq() {
-                self.stretch = 0;
-                self.stretch_target = (2 * self.stretch_target).min(LONGEST_STRETCH);
+                self.failed_return();
                 return Ok(());
             }
             built = Some(model);
@@ -121,6 +119,13 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
 }
 
 impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
+    /// A return that did not take (or did not hold): the next stretch in
+    /// full space is twice as long, at most [`LONGEST_STRETCH`].
+    pub(super) fn failed_return(&mut self) {
+        self.stretch = 0;
+        self.stretch_target = (2 * self.stretch_target).min(LONGEST_STRETCH);
+    }
+
     /// The modal run on the trained vectors and `grown` under `loads`.
     pub(super) fn grown_run(&self, grown: &[Vec<f64>], loads: &Loads) -> Result<Run<Modal<F>, R>, PhysicsError> {
         let scene = self.full.space.scene();

@@ -364,7 +364,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     fn shorter_than_the_stretch(&mut self) {
         let returned = self.tally.steps > self.tally.reduced_steps;
         if returned && self.stretch < self.stretch_target {
-            self.stretch_target = (2 * self.stretch_target).min(LONGEST_STRETCH);
+            self.failed_return();
         }
     }
 }
