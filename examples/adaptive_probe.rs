@@ -1,13 +1,14 @@
 //! The adaptive reduction against full space on cloth N x N (undamped,
 //! explicit, 0.01 s steps, 0.6 s), with gravity set after set-up to the
 //! canonical load, a load inside the training program it never ran, and
-//! two far outside it: E, errorEstimate, the share of steps reduced, the
+//! two far outside it (and `turned`: the canonical load, gravity turned sideways in
+//! the sheet's plane at 0.25 s, as the study's `-turned` scenes): E, errorEstimate, the share of steps reduced, the
 //! basis size every 0.1 s, and the run time against full space
 //! (`docs/method.md`, section 10).
 //!
 //! `cargo run --release --example adaptive_probe -- [N] [TOLERANCE]` (`ONLY=case` runs one case,
 //! `STEPS=k` k steps instead of 60, `STEP=h` steps of h s instead of 0.01, `CUBATURE=1` cubature
-//! forces, `TRACE=case` every step with its forceResidual, `FINE=h` full space at internal steps of h)
+//! forces, `TRACE=case` every step with its forceResidual, `FINE=h` full space at internal steps of h, `DAMPED=1` the scene's damping)
 
 use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::physics::*;
@@ -25,14 +26,17 @@ fn main() {
     let nx: usize = args.get(0).map_or(30, |v| v.parse().unwrap());
     let tol: f64 = args.get(1).map_or(0.01, |v| v.parse().unwrap());
     let mut base = canonical_scenes::cloth(nx, nx);
-    base.loads.damping_alpha = 0.0;
-    base.loads.damping_beta = 0.0;
+    if std::env::var("DAMPED").is_err() {
+        base.loads.damping_alpha = 0.0;
+        base.loads.damping_beta = 0.0;
+    }
     let cases = [
         ("canonical", gravity(1.0, 0.0, 0.0)),
         ("inside", gravity(0.85, 10.0, 10.0)),
         ("sideways", [9.81, 0.0, 0.0]),
         ("2g70", gravity(2.0, 70.0, 0.0)),
         ("point", gravity(1.0, 0.0, 0.0)),
+        ("turned", gravity(1.0, 0.0, 0.0)),
     ];
     let weight = base.grid.node_mass * (nx * nx) as f64 * 9.81;
     let fine: f64 = std::env::var("FINE").ok().map_or(0.0, |v| v.parse().unwrap());
@@ -68,6 +72,13 @@ fn main() {
         let (mut tf, mut tm) = (0.0, 0.0);
         let steps: usize = std::env::var("STEPS").ok().map_or(60, |v| v.parse().unwrap());
         for k in 1..=steps {
+            if name == "turned" && ((k - 1) as f64 * H - 0.25).abs() < 0.5 * H {
+                // Gravity turned sideways in the sheet's plane, as the study's `-turned` scenes do.
+                for s in [&mut f, &mut m] {
+                    let l = Loads { gravity: [9.81, 0.0, 0.0], ..s.loads().clone() };
+                    s.set_loads(&l).unwrap();
+                }
+            }
             let t = Instant::now();
             f.do_step(H).unwrap();
             tf += t.elapsed().as_secs_f64();

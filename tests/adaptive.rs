@@ -165,7 +165,7 @@ fn past_its_program_a_large_cloth_falls_back_on_the_force_its_error_model_cannot
 
 /// An adaptive run (tolerance 0.01) from set-up to step `steps` with the
 /// loads `load(k, loads)` before step k, from `from` (a snapshot taken before
-/// step `at`) if given: the positions after each step, snapshots before the
+/// step `at`) if given: the positions and the estimate after each step, snapshots before the
 /// steps `snapshots_at` and the basis size there.
 fn positions_under(
     load: fn(usize, &Loads) -> Loads,
@@ -194,7 +194,10 @@ fn positions_under(
         let loads = load(k, sim.loads());
         sim.set_loads(&loads).unwrap();
         sim.do_step(H).unwrap();
-        positions.push(sim.positions().to_vec());
+        // The positions and the estimate (in full space, moved on by the twin from the state and the error restored).
+        let mut x = sim.positions().to_vec();
+        x.push(sim.reduction_status().error_estimate);
+        positions.push(x);
     }
     (positions, snapshots, sizes)
 }

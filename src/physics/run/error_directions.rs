@@ -385,13 +385,16 @@ impl DirectionModel {
         }
     }
 
-    /// Ψ z and Ψ z' over the free DOFs.
-    pub fn error_of(&self, s: &ErrorState) -> (Vec<f64>, Vec<f64>) {
-        let k = self.k.max(1);
-        let along = |c: &[f64]| -> Vec<f64> { self.psi.chunks_exact(k).map(|row| row.iter().zip(c).map(|(p, x)| p * x).sum()).collect() };
+    /// Ψ z and Ψ z' over the free DOFs into `e` and `v` (n each).
+    pub fn error_into(&self, s: &ErrorState, e: &mut [f64], v: &mut [f64]) {
         if self.k == 0 {
-            return (vec![0.0; self.n], vec![0.0; self.n]);
+            e.fill(0.0);
+            v.fill(0.0);
+            return;
         }
-        (along(&s.e), along(&s.v))
+        for ((row, e), v) in self.psi.chunks_exact(self.k).zip(e.iter_mut()).zip(v.iter_mut()) {
+            *e = row.iter().zip(&s.e).map(|(p, x)| p * x).sum();
+            *v = row.iter().zip(&s.v).map(|(p, x)| p * x).sum();
+        }
     }
 }

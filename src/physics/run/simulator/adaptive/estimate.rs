@@ -15,69 +15,53 @@ use crate::physics::setup::modes::ModalBasis;
 impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// The estimate over the `since` seconds since the last one: the error
     /// model's step under the residual at the state, at the tangent there
-    /// (in full space: no residual, the full-space model at the tangent of
-    /// the last reduced estimate, nothing at all while no error is carried);
+    /// (in full space: the error the twin moved on, [`super::twin`]);
     /// its ‖e‖² and the motion stand for the `wait` communication steps since the last estimate.
     pub(super) fn estimate(&mut self) -> Result<(), PhysicsError> {
-        let carried = self.error.e.iter().chain(&self.error.v).chain(&self.error.a).any(|x| *x != 0.0);
         self.unseen_sq = 0.0;
         let d = self.reduced.space.scene().dim;
         // The motion from the slot positions the estimate has anyway.
         let mut motion = None;
         match &mut self.model {
-            // In full space no error is added: a zero error stays zero, a carried one moves on.
-            _ if self.in_full && !carried => {}
+            // In full space no error is added: the twin moves a carried one on (twin.rs).
+            _ if self.in_full => {}
             Estimator::Full(model) => {
-                if self.in_full {
-                    // At the tangent of the full-space state: a carried error
-                    // grows or shrinks as the trajectory's own sensitivity there says.
-                    self.residual.fill(0.0);
-                    let x = self.full.space.positions(&self.full.state.y, &mut self.full.work);
-                    model.relinearize(self.full.space.scene(), x);
-                } else {
-                    let felt = self.reduced.felt_loads();
-                    let q = &self.reduced.state.y;
-                    self.reduced.space.residual_force(&felt.gravity, &felt.point_load, q, &mut self.reduced.work, &mut self.residual);
-                    self.reduced.current = false;
-                    let x = self.reduced.space.positions(&self.reduced.state.y, &mut self.reduced.work);
-                    motion = Some(slot_motion(x, &self.start, &self.slot_mass, d));
-                    model.relinearize(self.reduced.space.scene(), x);
-                }
+                let felt = self.reduced.felt_loads();
+                let q = &self.reduced.state.y;
+                self.reduced.space.residual_force(&felt.gravity, &felt.point_load, q, &mut self.reduced.work, &mut self.residual);
+                self.reduced.current = false;
+                let x = self.reduced.space.positions(&self.reduced.state.y, &mut self.reduced.work);
+                motion = Some(slot_motion(x, &self.start, &self.slot_mass, d));
+                model.relinearize(self.reduced.space.scene(), x);
                 model.advance(&mut self.error, self.since, &self.residual)?;
             }
             Estimator::Directions(model) => {
-                if self.in_full {
-                    let x = self.full.space.positions(&self.full.state.y, &mut self.full.work);
-                    model.ends_at(self.full.space.scene(), x);
-                    model.linearize(self.full.space.scene(), None);
-                } else {
-                    let felt = self.reduced.felt_loads();
-                    // Once the estimates are half their longest gap apart (a pass over every spring).
-                    if 2 * self.gap >= self.period {
-                        self.unseen_sq = unseen_share_sq(&mut self.reduced, model, &mut self.residual);
-                    }
-                    let space = &self.reduced.space;
-                    let scene = space.scene();
-                    let point = self.reduced.work.as_ref().point_force_as(&felt.point_load, scene).map(|(dof, f)| {
-                        let mut p = [0.0; 3];
-                        p[..f.len()].copy_from_slice(f);
-                        (dof, p, f.len())
-                    });
-                    // The sampled springs' ends and the motion from q, without expanding x.
-                    let q = &self.reduced.state.y;
-                    let slots = space.slots_mut(&mut self.reduced.work);
-                    model.ends_modal(scene, space.basis(), &space.modes().point, q, slots);
-                    let n = space.basis().n;
-                    let free: f64 = q.iter().zip(&self.motion_reference).map(|(q, b)| q * q + 2.0 * q * b).sum::<f64>() + self.motion_offset;
-                    let held = slot_motion(&slots[n..], &self.start[n..], &self.slot_mass[n / d..], d);
-                    motion = Some(free.max(0.0) + held);
-                    let point = point.as_ref().map(|(dof, p, d)| (*dof, &p[..*d]));
-                    model.linearize(scene, Some((&felt.gravity, point)));
+                let felt = self.reduced.felt_loads();
+                // Once the estimates are half their longest gap apart (a pass over every spring).
+                if 2 * self.gap >= self.period {
+                    self.unseen_sq = unseen_share_sq(&mut self.reduced, model, &mut self.residual);
                 }
+                let space = &self.reduced.space;
+                let scene = space.scene();
+                let point = self.reduced.work.as_ref().point_force_as(&felt.point_load, scene).map(|(dof, f)| {
+                    let mut p = [0.0; 3];
+                    p[..f.len()].copy_from_slice(f);
+                    (dof, p, f.len())
+                });
+                // The sampled springs' ends and the motion from q, without expanding x.
+                let q = &self.reduced.state.y;
+                let slots = space.slots_mut(&mut self.reduced.work);
+                model.ends_modal(scene, space.basis(), &space.modes().point, q, slots);
+                let n = space.basis().n;
+                let free: f64 = q.iter().zip(&self.motion_reference).map(|(q, b)| q * q + 2.0 * q * b).sum::<f64>() + self.motion_offset;
+                let held = slot_motion(&slots[n..], &self.start[n..], &self.slot_mass[n / d..], d);
+                motion = Some(free.max(0.0) + held);
+                let point = point.as_ref().map(|(dof, p, d)| (*dof, &p[..*d]));
+                model.linearize(scene, Some((&felt.gravity, point)));
                 model.advance(&mut self.error, self.since)?;
             }
         }
-        self.last_error_sq = self.model.norm_sq(&self.error);
+        self.last_error_sq = if self.in_full { self.full_error_sq() } else { self.model.norm_sq(&self.error) };
         self.last_motion_sq = match motion {
             Some(m) => m,
             None => self.motion_sq(),
@@ -163,8 +147,13 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
                 self.error.v.iter_mut().zip(left_rate).for_each(|(e, l)| *e += l);
                 self.error.a.fill(0.0);
             }
-            Estimator::Directions(old) => {
-                let (mut e, mut v) = old.error_of(&self.error);
+            Estimator::Directions(_) => {
+                // Over the free DOFs in full space (twin.rs), where a return starts;
+                // `carried` takes them back, for the next fall-back.
+                let n = left.len();
+                let old = std::mem::replace(&mut self.error, ErrorState::zero(0));
+                let (mut e, mut v) = if old.e.len() == n { (old.e.clone(), old.v.clone()) } else { (vec![0.0; n], vec![0.0; n]) };
+                self.carried = if old.e.len() == n { old } else { ErrorState::zero(n) };
                 e.iter_mut().zip(left).for_each(|(e, l)| *e += l);
                 v.iter_mut().zip(left_rate).for_each(|(e, l)| *e += l);
                 let model = built.unwrap_or_else(|| {

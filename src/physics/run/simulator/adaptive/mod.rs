@@ -15,8 +15,9 @@
 //!   force drives. Loads outside the training program
 //!   (gravity scaled or turned beyond it, a point load it did not run)
 //!   fall back before the step: the basis was not trained for them.
-//! - Full: the error model holds the error carried from the reduced
-//!   stretch (full space adds none). Every communication step keeps the
+//! - Full: the error carried from the reduced stretch moves on as the
+//!   distance between the run and a twin of it started that error away
+//!   ([`twin`]; full space adds none). Every communication step keeps the
 //!   displacement it reached; after a stretch of [`STRETCH`] steps (doubled
 //!   after each return that fails) the directions the stretch saw that the
 //!   basis does not hold join it ([`adaptive_basis`]; with cubature forces
@@ -34,6 +35,7 @@ mod estimate;
 mod returns;
 mod runs;
 mod sheet;
+mod twin;
 mod unseen;
 
 use runs::{inner_settings, reduced_run, slot_masses, slot_motion};
@@ -156,6 +158,12 @@ pub struct Adaptive<F: ReducedForce, R: Scheme, X: Scheme> {
     /// The state the full-space run takes on a fall-back, and the reduced run's state to undo a step to.
     lifted: State,
     rewind: State,
+    /// The full-space run that moves a carried error on (where the run
+    /// reduces) and its state ([`twin`]); in error directions, the error
+    /// over the free DOFs while in full space, or the one in directions.
+    twin: Option<Box<Run<Full, X>>>,
+    twin_state: State,
+    carried: ErrorState,
     /// Φᵀ M Δc of a holder's kick (see [`Self::kick_error`]).
     kick_q: Vec<f64>,
     stretch_target: usize,
@@ -235,6 +243,9 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             stretch: 0,
             lifted: State::at_rest(n),
             rewind: State::at_rest(0),
+            twin: None,
+            twin_state: State::at_rest(n),
+            carried: ErrorState::zero(n),
             kick_q: Vec::new(),
             stretch_target: STRETCH,
             settings: settings.clone(),
@@ -252,7 +263,9 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         run.set_motion_reference();
         run.rewind = run.reduced.state.clone();
         run.kick_q = vec![0.0; run.reduced.space.basis().r];
-        if !run.reduces {
+        if run.reduces {
+            run.twin = Some(twin::make_twin(&run.full, settings, loads)?);
+        } else {
             run.lift();
         }
         run.report_basis();
@@ -428,15 +441,17 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         self.seen_next = 0;
         self.stretch = 0;
         self.estimate_soon();
+        self.error_into_full();
     }
 
     fn step_full(&mut self, h: f64) -> Result<(), PhysicsError> {
-        self.full.do_step(h)?;
+        self.step_full_carrying(h)?;
         self.tally.steps += self.full.internal_steps_last as u64;
         self.wait += 1;
         self.since += h;
-        if self.wait >= self.gap {
-            // Full space adds no error; the error carried moves on with the linearized dynamics.
+        if self.wait >= self.gap || self.carries_error() {
+            // Full space adds no error; the error carried moves on with the
+            // twin, which knows it at every step (an estimate costs O(n) here).
             self.update_period();
             self.estimate()?;
         }

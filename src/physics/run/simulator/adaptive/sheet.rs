@@ -143,9 +143,11 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
             (Some(run), Estimator::Directions(_)) => Some(Estimator::new(self.reduced.scene(), &self.chosen, run.space.basis())?.0),
             _ => None,
         };
-        let error_len = match &model {
-            Some(Estimator::Directions(m)) => m.directions(),
-            _ => self.error.e.len(),
+        // In full space the error is over the free DOFs (twin.rs).
+        let error_len = match model.as_ref().unwrap_or(&self.model) {
+            _ if part.in_full => n,
+            Estimator::Directions(m) => m.directions(),
+            Estimator::Full(_) => n,
         };
         let slot_values = self.reduced.scene().rest.len();
         if !part.fits(n, error_len) || !(part.linearized.is_empty() || part.linearized.len() == slot_values) {
@@ -177,6 +179,9 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
         let [e, v, a] = &part.error;
         self.error = ErrorState { e: e.clone(), v: v.clone(), a: a.clone() };
         self.spare_error = self.error.clone();
+        if self.carried.e.len() != n {
+            self.carried = ErrorState::zero(n);
+        }
         [self.tally.error_sq, self.tally.motion_sq, self.last_error_sq, self.last_motion_sq, self.since] = part.sums;
         [self.tally.reduced_steps, self.tally.steps, self.gap, self.period, self.wait] = part.counts;
         (self.stretch, self.stretch_target, self.seen_next) = (stretch, target, next);
