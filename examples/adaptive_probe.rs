@@ -72,8 +72,10 @@ fn main() {
         let (mut tf, mut tm) = (0.0, 0.0);
         let steps: usize = std::env::var("STEPS").ok().map_or(60, |v| v.parse().unwrap());
         let starts = [f.snapshot(), m.snapshot()];
+        // Step k of the `turned` case turns gravity sideways in the sheet's plane at 0.25 s.
+        let turns_at = |k: usize| name == "turned" && ((k - 1) as f64 * H - 0.25).abs() < 0.5 * H;
         for k in 1..=steps {
-            if name == "turned" && ((k - 1) as f64 * H - 0.25).abs() < 0.5 * H {
+            if turns_at(k) {
                 // Gravity turned sideways in the sheet's plane, as the study's `-turned` scenes do.
                 for s in [&mut f, &mut m] {
                     let l = Loads { gravity: [9.81, 0.0, 0.0], ..s.loads().clone() };
@@ -126,7 +128,7 @@ fn main() {
             s.restore(start).unwrap();
             let t0 = Instant::now();
             for k in 1..=steps {
-                if name == "turned" && ((k - 1) as f64 * H - 0.25).abs() < 0.5 * H {
+                if turns_at(k) {
                     let l = Loads { gravity: [9.81, 0.0, 0.0], ..s.loads().clone() };
                     s.set_loads(&l).unwrap();
                 }

@@ -37,8 +37,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             }
             Estimator::Directions(model) => {
                 let felt = self.reduced.felt_loads();
-                // Once the estimates are their longest gap apart (a pass over every
-                // spring, about 3 full-space steps on cloth 100 x 100): once per longest gap.
+                // Once per longest gap between estimates (a pass over every spring,
+                // about 3 full-space steps on cloth 100 x 100).
                 if self.gap >= self.period {
                     self.unseen_sq = unseen_share_sq(&mut self.reduced, model, &mut self.residual);
                 }
