@@ -24,7 +24,7 @@ fn params(scene: &str, linearization: i64, force: i64) -> Params {
 }
 
 /// A resources folder with startValues.txt for `p` and, if given, setup.bin.
-fn resources(tag: &str, p: &Params, baked: Option<&[u8]>) -> String {
+pub(crate) fn resources(tag: &str, p: &Params, baked: Option<&[u8]>) -> String {
     let dir = std::env::temp_dir().join(format!("mms-bake-{}-{tag}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let text: String = modal_mass_spring::fmi::variables::VARIABLES
@@ -267,7 +267,7 @@ fn full_space_has_nothing_to_bake() {
 
 /// cloth-3d on `n` x `n` nodes with reduction = adaptive at `tolerance`,
 /// with exact forces (1) or cubature forces asked for (2), 4 reported modes.
-fn adaptive(n: usize, tolerance: f64, force: i64) -> Params {
+pub(crate) fn adaptive(n: usize, tolerance: f64, force: i64) -> Params {
     let mut p = Params::canonical("cloth-3d").unwrap();
     p.set(vr::NX, &[n as f64]);
     p.set(vr::NY, &[n as f64]);

@@ -23,6 +23,7 @@ mod basis;
 mod cubature;
 mod defaults;
 mod fmi_abi;
+mod fmi_adaptive_log;
 mod fmi_import;
 mod fmi_mode_classes;
 mod fmi_model_description;

@@ -22,6 +22,9 @@ pub enum StepEnd {
     Done,
     /// Taken, with a warning for the host (the glue logs it and returns fmi3Warning).
     Warning(String),
+    /// Taken, with an event for the log (the glue logs it in the category
+    /// logEvents when logging is on, and returns fmi3OK).
+    Event(String),
 }
 
 /// A model the glue exports. Messages returned as `Err` are complete

@@ -4,7 +4,7 @@
 use crate::fmi::params::Params;
 use crate::fmi::variables::vr;
 use crate::options::{Integrator, Reduction};
-use crate::physics::{HolderProblem, PhysicsError, Quantity, StepFailure};
+use crate::physics::{FallBackCause, HolderProblem, PhysicsError, Quantity, ReductionStatus, StepFailure, Switch};
 
 /// The variable that sets `q`.
 pub fn variable(q: Quantity) -> &'static str {
@@ -34,6 +34,39 @@ pub fn variable(q: Quantity) -> &'static str {
         Quantity::Holders => "nHolders",
         Quantity::HolderMotion => "anchor{k}X ... anchor{k}RZ",
     }
+}
+
+/// An adaptive run's last fall-back or return (`docs/method.md`, section
+/// 10) for the log; `time0` is the start time of the run.
+pub fn switch(status: &ReductionStatus, time0: f64) -> String {
+    let (fraction, estimate) = (status.reduced_fraction, status.error_estimate);
+    match status.last_switch {
+        Switch::FallBack { time, why } => {
+            let cause = match why {
+                FallBackCause::OutsideProgram => "gravity or the point load is outside the training program (trainingScale, trainingTilt)".to_string(),
+                FallBackCause::Error { estimate, limit } => {
+                    format!("the estimated error of the state reached {estimate:.2e} of the motion, above {limit:.2e} (0.4 errorTolerance)")
+                }
+                FallBackCause::Unseen { share, limit } => format!(
+                    "the force the error model cannot see reached {share:.2} of the load, above {limit:.2}; errorEstimate \
+                     leaves out the error that force drove before (it may read low from here)"
+                ),
+            };
+            format!("reduction = adaptive: full space from t = {} ({cause}); errorEstimate {estimate:.2e}, reducedFraction {fraction:.3}", time0 + time)
+        }
+        Switch::Return { time, vectors } => format!(
+            "reduction = adaptive: back to the reduced model at t = {} on {vectors} vectors; errorEstimate {estimate:.2e}, \
+             reducedFraction {fraction:.3}",
+            seconds(time0 + time)
+        ),
+        Switch::None => "reduction = adaptive: no switch".to_string(),
+    }
+}
+
+/// A time to nine decimals, without trailing zeros (0.13999999999999999 as 0.14).
+fn seconds(t: f64) -> String {
+    let s = format!("{t:.9}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// `e` in the words of the model description, for an instance with values `p`.

@@ -233,9 +233,18 @@ impl Model for MassSpring {
 
     fn do_step(&mut self, p: &Params, h: f64, time0: f64) -> Result<StepEnd, String> {
         let sim = self.sim.as_mut().expect("Step Mode has a simulator");
+        let adaptive = sim.settings().reduction == crate::options::Reduction::Adaptive;
+        let switches = if adaptive { sim.reduction_status().switches } else { 0 };
         if let Err(e) = sim.do_step(h) {
             return Err(messages::describe(&e, p));
         }
+        // An adaptive run's fall-back or return (at most one a step) goes to the log.
+        let event = if adaptive {
+            let status = sim.reduction_status();
+            (status.switches != switches).then(|| messages::switch(&status, time0))
+        } else {
+            None
+        };
         // The trained range costs r operations; a limit of 0 turns it off.
         let range_limit = p.scalar(vr::TRAINING_RANGE_LIMIT);
         if !self.range_warned && range_limit > 0.0 {
@@ -243,19 +252,27 @@ impl Model for MassSpring {
             if distance > range_limit {
                 self.range_warned = true;
                 let end = time0 + sim.time();
-                return Ok(StepEnd::Warning(format!(
+                let warning = format!(
                     "at t = {end} trainingRange = {distance:.3} passed trainingRangeLimit = {range_limit}: the run has left the \
                      positions the trained basis was trained on (gravity, point load or holder motion outside the training \
                      program); the results may leave the full-space model (widen trainingScale or trainingTilt, or bake the \
                      basis for these loads)"
-                )));
+                );
+                // A switch in the same step is said with it.
+                return Ok(StepEnd::Warning(match event {
+                    Some(e) => format!("{warning}; {e}"),
+                    None => warning,
+                }));
             }
         }
         // A check costs one pass over every spring; a limit of 0 turns it off.
         // An adaptive run watches its own error and falls back to full space
         // itself (forceResidual is still computed when read).
         let limit = p.scalar(vr::FORCE_RESIDUAL_LIMIT);
-        if self.residual_warned || limit <= 0.0 || sim.settings().reduction == crate::options::Reduction::Adaptive {
+        if adaptive {
+            return Ok(event.map_or(StepEnd::Done, StepEnd::Event));
+        }
+        if self.residual_warned || limit <= 0.0 {
             return Ok(StepEnd::Done);
         }
         self.residual_wait += 1;

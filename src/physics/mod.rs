@@ -23,7 +23,9 @@ pub mod vector_unit;
 pub use error::{HolderProblem, PhysicsError, Quantity, StepFailure};
 pub use run::integrator::EXPLICIT_SAFETY;
 pub use run::simulator::registry::Simulator;
-pub use run::simulator::{internal_step_count, Reads, ReductionStatus, SetUp, Sheet, Steps, MAX_INTERNAL_STEPS_PER_CALL, STEP_COUNT_TOLERANCE};
+pub use run::simulator::{
+    internal_step_count, FallBackCause, Reads, ReductionStatus, SetUp, Sheet, Steps, Switch, MAX_INTERNAL_STEPS_PER_CALL, STEP_COUNT_TOLERANCE,
+};
 pub use run::state::{AdaptivePart, Loads, Motion, Pose, Snapshot, State, OTHER_HOLDERS};
 pub use settings::{ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction, Settings, TrainingProgram};
 pub use setup::adaptive_basis::DOFS_PER_VECTOR as ADAPTIVE_DOFS_PER_VECTOR;

@@ -130,6 +130,10 @@ impl Instance {
                         self.log.log(WARNING, &format!("{F}: {m}"));
                         Ok(WARNING)
                     }
+                    StepEnd::Event(m) => {
+                        self.log.log(OK, &format!("{F}: {m}"));
+                        Ok(OK)
+                    }
                 }
             }
             Err(why) => {

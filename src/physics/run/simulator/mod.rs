@@ -34,7 +34,7 @@ mod stepping;
 
 use std::marker::PhantomData;
 
-pub use sheet::{Reads, ReductionStatus, SetUp, Sheet, Steps};
+pub use sheet::{FallBackCause, Reads, ReductionStatus, SetUp, Sheet, Steps, Switch};
 
 use crate::physics::run::frame::into_frame;
 use crate::physics::run::integrator::{Buffers, Scheme};

@@ -7,8 +7,8 @@
 //! when first asked for after a step and kept until the state changes
 //! (the run's `fresh`).
 
-use super::ReductionStatus;
 use super::{to_node_order, Reads, Run, SetUp, Steps};
+use super::{ReductionStatus, Switch};
 use crate::physics::error::PhysicsError;
 use crate::physics::run::frame::{apply, apply_transposed, cross, dot, ground_velocity, place, rotation};
 use crate::physics::run::holders::{self, Placement};
@@ -351,6 +351,8 @@ impl<S: Readout, I: Scheme> SetUp for Run<S, I> {
             chosen_size: kept.unwrap_or(self.space.scene().n_dofs()),
             reduces: kept.is_some(),
             error_directions: 0,
+            switches: 0,
+            last_switch: Switch::None,
         }
     }
 }

@@ -151,6 +151,38 @@ pub struct ReductionStatus {
     pub reduces: bool,
     /// The error model's directions (an adaptive run with cubature forces), 0 where it works in full space or there is none.
     pub error_directions: usize,
+    /// Switches between the reduced model and full space so far (an
+    /// adaptive run's fall-backs and returns), and the last of them.
+    pub switches: u64,
+    pub last_switch: Switch,
+}
+
+/// A switch of an adaptive run between its reduced model and full space
+/// (`docs/method.md`, section 10), at `time` since set-up [s].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Switch {
+    None,
+    /// To full space, at the start of the step from `time`.
+    FallBack {
+        time: f64,
+        why: FallBackCause,
+    },
+    /// Back to the reduced model at `time`, on `vectors` basis vectors.
+    Return {
+        time: f64,
+        vectors: usize,
+    },
+}
+
+/// Why an adaptive run went to full space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FallBackCause {
+    /// Gravity or the point load outside the training program.
+    OutsideProgram,
+    /// The estimated error of the state passed `limit` (both relative to the motion).
+    Error { estimate: f64, limit: f64 },
+    /// The residual force the error directions do not see passed `limit` (both relative to the load).
+    Unseen { share: f64, limit: f64 },
 }
 
 /// A run: everything [`super::Simulator`] offers.

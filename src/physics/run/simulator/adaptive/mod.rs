@@ -40,7 +40,7 @@ mod unseen;
 
 use runs::{inner_settings, reduced_run, slot_masses, slot_motion};
 
-use super::{Reads, Run, SetUp, Steps};
+use super::{FallBackCause, Reads, Run, SetUp, Steps, Switch};
 use crate::physics::error::{Expected, PhysicsError, Quantity};
 use crate::physics::run::error_model::ErrorState;
 use crate::physics::run::frame::dot;
@@ -178,6 +178,9 @@ pub struct Adaptive<F: ReducedForce, R: Scheme, X: Scheme> {
     reported: ModalBasis,
     frequencies: Vec<f64>,
     coordinates: Vec<f64>,
+    /// Fall-backs and returns so far, and the last (for the host's log; not part of the state).
+    switches: u64,
+    last_switch: Switch,
 }
 
 /// Mode weights act on a fixed basis: an adaptive run refuses any but 1.
@@ -257,6 +260,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             frequencies: vec![0.0; settings.n_modes],
             coordinates: vec![0.0; settings.n_modes],
             chosen,
+            switches: 0,
+            last_switch: Switch::None,
         };
         run.start = run.reduced.space.positions(&run.reduced.state.y, &mut run.reduced.work).to_vec();
         run.reduced.current = false;
@@ -415,6 +420,22 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         let motion = self.last_motion_sq.max(self.chosen.choice.motion_scale.powi(2));
         let error = self.last_error_sq;
         !(error <= (FALL_BACK * self.settings.error_tolerance).powi(2) * motion && self.unseen_sq <= self.unseen_limit_sq())
+    }
+
+    /// Why the last estimate makes the run fall back.
+    fn fall_back_cause(&self) -> FallBackCause {
+        let limit_sq = self.unseen_limit_sq();
+        if self.unseen_sq > limit_sq {
+            return FallBackCause::Unseen { share: self.unseen_sq.sqrt(), limit: limit_sq.sqrt() };
+        }
+        let motion = self.last_motion_sq.max(self.chosen.choice.motion_scale.powi(2));
+        FallBackCause::Error { estimate: (self.last_error_sq / motion).sqrt(), limit: FALL_BACK * self.settings.error_tolerance }
+    }
+
+    /// Counts a fall-back or a return.
+    fn switched(&mut self, switch: Switch) {
+        self.switches += 1;
+        self.last_switch = switch;
     }
 
     /// The reduced run's state undone to the start of its last step.

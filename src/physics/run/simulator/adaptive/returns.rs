@@ -9,7 +9,7 @@ use super::{Adaptive, LONGEST_STRETCH};
 use crate::physics::error::PhysicsError;
 use crate::physics::run::integrator::Scheme;
 use crate::physics::run::simulator::estimators::Estimator;
-use crate::physics::run::simulator::Run;
+use crate::physics::run::simulator::{Run, Switch};
 use crate::physics::run::space::{Constants, Modal, ReducedForce};
 use crate::physics::run::state::Loads;
 use crate::physics::setup::adaptive_basis::{self, CAP_FACTOR, GROWTH, PROJECTION_SHARE};
@@ -114,6 +114,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         self.stretch = 0;
         self.estimate_soon();
         self.report_basis();
+        self.switched(Switch::Return { time: self.full.state.time, vectors: self.reduced.space.basis().r });
         Ok(())
     }
 }

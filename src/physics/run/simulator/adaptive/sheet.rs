@@ -6,7 +6,7 @@ use crate::physics::error::{positive, PhysicsError, Quantity};
 use crate::physics::run::error_model::ErrorState;
 use crate::physics::run::integrator::Scheme;
 use crate::physics::run::simulator::estimators::Estimator;
-use crate::physics::run::simulator::{Reads, ReductionStatus, SetUp, Steps};
+use crate::physics::run::simulator::{FallBackCause, Reads, ReductionStatus, SetUp, Steps, Switch};
 use crate::physics::run::space::ReducedForce;
 use crate::physics::run::state::{AdaptivePart, Loads, Snapshot};
 use crate::physics::settings::Settings;
@@ -294,6 +294,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> SetUp for Adaptive<F, R, X> {
                 Estimator::Directions(m) => m.directions(),
                 Estimator::Full(_) => 0,
             },
+            switches: self.switches,
+            last_switch: self.last_switch,
         }
     }
 }
@@ -308,6 +310,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         }
         if self.outside_program() {
             // A basis trained for other loads: full space from the start of the step.
+            self.switched(Switch::FallBack { time: self.reduced.state.time, why: FallBackCause::OutsideProgram });
             self.lift();
             return self.step_full(h).inspect(|_| self.report_coordinates());
         }
@@ -335,12 +338,14 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             return Ok(());
         }
         // Undone, and taken again in full space from the lifted state.
+        let why = self.fall_back_cause();
         self.error.copy_from(&self.spare_error);
         self.tally = self.spare_tally;
         self.wait = wait;
         self.since = since;
         self.undo_reduced();
         estimated?;
+        self.switched(Switch::FallBack { time: self.reduced.state.time, why });
         self.shorter_than_the_stretch();
         self.lift();
         if let Err(e) = self.step_full(h) {
