@@ -79,6 +79,11 @@ pub const ESTIMATE_COST: f64 = 10.0;
 pub const ESTIMATE_SHARE: f64 = 0.25;
 /// The longest gap between two estimates, in communication steps.
 pub const LONGEST_GAP: u64 = 32;
+/// The longest gap between two estimates in simulated time [s] (32 steps
+/// of 0.01 s): with steps of 1/60 s the unseen force's check came 0.53 s
+/// apart, and on cloth 100 x 100 the run fell back at 1.05 s instead of
+/// 0.82 s, with E 0.0098 at 1.5 s against 0.0016 (`docs/method.md`, section 10).
+pub const LONGEST_GAP_SECONDS: f64 = 0.32;
 /// The most poses of a stretch in full space kept for the basis to grow by.
 pub const KEPT_POSES: usize = 32;
 
@@ -361,8 +366,9 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// The longest gap between estimates: one estimate (a spring pass, the
     /// tangent's assembly, a factorization and a solve: about
     /// [`ESTIMATE_COST`] passes over every spring) costs at most
-    /// [`ESTIMATE_SHARE`] of the springs the steps between visit.
-    fn update_period(&mut self) {
+    /// [`ESTIMATE_SHARE`] of the springs the steps between visit, and
+    /// at most [`LONGEST_GAP`] steps of `h` and [`LONGEST_GAP_SECONDS`] apart.
+    fn update_period(&mut self, h: f64) {
         let all = self.reduced.scene().springs.len() as f64;
         let visited = if self.in_full {
             all * self.full.internal_steps_last.max(1) as f64
@@ -370,6 +376,9 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             (self.reduced.cubature_springs() * self.reduced.internal_steps_last.max(1)) as f64
         };
         self.period = ((ESTIMATE_COST * all / (ESTIMATE_SHARE * visited)).ceil() as u64).clamp(1, LONGEST_GAP);
+        // And at most LONGEST_GAP_SECONDS apart, whatever the step.
+        let in_time = ((LONGEST_GAP_SECONDS / h * (1.0 + 1e-9)).floor() as u64).max(1);
+        self.period = self.period.min(in_time);
     }
 
     /// Estimates from the next step on again 1, 2, 4, ... steps apart (after a change).
@@ -473,7 +482,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         if self.wait >= self.gap || self.carries_error() {
             // Full space adds no error; the error carried moves on with the
             // twin, which knows it at every step (an estimate costs O(n) here).
-            self.update_period();
+            self.update_period(h);
             self.estimate()?;
         }
         self.stretch += 1;

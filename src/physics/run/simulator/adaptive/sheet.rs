@@ -331,7 +331,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             self.held_reduced();
             return Ok(());
         }
-        self.update_period();
+        self.update_period(h);
         let estimated = self.estimate();
         if estimated.is_ok() && !self.must_fall_back() {
             self.held_reduced();
