@@ -52,7 +52,10 @@ pub fn switch(status: &ReductionStatus, time0: f64) -> String {
                      leaves out the error that force drove before (it may read low from here)"
                 ),
             };
-            format!("reduction = adaptive: full space from t = {} ({cause}); errorEstimate {estimate:.2e}, reducedFraction {fraction:.3}", time0 + time)
+            format!(
+                "reduction = adaptive: full space from t = {} ({cause}); errorEstimate {estimate:.2e}, reducedFraction {fraction:.3}",
+                seconds(time0 + time)
+            )
         }
         Switch::Return { time, vectors } => format!(
             "reduction = adaptive: back to the reduced model at t = {} on {vectors} vectors; errorEstimate {estimate:.2e}, \

@@ -423,22 +423,17 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         UNSEEN_FLOOR.max(UNSEEN_PER_TOLERANCE * self.settings.error_tolerance).powi(2)
     }
 
-    /// The estimated error of the state has passed its share of the tolerance,
-    /// or the residual the error model does not see its limit.
-    fn must_fall_back(&self) -> bool {
-        let motion = self.last_motion_sq.max(self.chosen.choice.motion_scale.powi(2));
-        let error = self.last_error_sq;
-        !(error <= (FALL_BACK * self.settings.error_tolerance).powi(2) * motion && self.unseen_sq <= self.unseen_limit_sq())
-    }
-
-    /// Why the last estimate makes the run fall back.
-    fn fall_back_cause(&self) -> FallBackCause {
+    /// Why the last estimate makes the run fall back, if it does: the
+    /// residual the error model does not see has passed its limit, or the
+    /// estimated error of the state its share of the tolerance (a NaN falls back).
+    fn fall_back_cause(&self) -> Option<FallBackCause> {
         let limit_sq = self.unseen_limit_sq();
-        if self.unseen_sq > limit_sq {
-            return FallBackCause::Unseen { share: self.unseen_sq.sqrt(), limit: limit_sq.sqrt() };
+        if !(self.unseen_sq <= limit_sq) {
+            return Some(FallBackCause::Unseen { share: self.unseen_sq.sqrt(), limit: limit_sq.sqrt() });
         }
         let motion = self.last_motion_sq.max(self.chosen.choice.motion_scale.powi(2));
-        FallBackCause::Error { estimate: (self.last_error_sq / motion).sqrt(), limit: FALL_BACK * self.settings.error_tolerance }
+        let limit = FALL_BACK * self.settings.error_tolerance;
+        (!(self.last_error_sq <= limit.powi(2) * motion)).then(|| FallBackCause::Error { estimate: (self.last_error_sq / motion).sqrt(), limit })
     }
 
     /// Counts a fall-back or a return.

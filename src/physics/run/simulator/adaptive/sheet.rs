@@ -333,19 +333,21 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         }
         self.update_period(h);
         let estimated = self.estimate();
-        if estimated.is_ok() && !self.must_fall_back() {
+        let why = if estimated.is_ok() { self.fall_back_cause() } else { None };
+        if estimated.is_ok() && why.is_none() {
             self.held_reduced();
             return Ok(());
         }
         // Undone, and taken again in full space from the lifted state.
-        let why = self.fall_back_cause();
         self.error.copy_from(&self.spare_error);
         self.tally = self.spare_tally;
         self.wait = wait;
         self.since = since;
         self.undo_reduced();
         estimated?;
-        self.switched(Switch::FallBack { time: self.reduced.state.time, why });
+        if let Some(why) = why {
+            self.switched(Switch::FallBack { time: self.reduced.state.time, why });
+        }
         self.shorter_than_the_stretch();
         self.lift();
         if let Err(e) = self.step_full(h) {
