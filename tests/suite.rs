@@ -1,7 +1,6 @@
 //! Every integration test of the crate, one module per file of tests/, in
-//! one test binary: each binary links the whole solver with thin LTO (some
-//! 30 s apiece), so one binary instead of one per file saves most of the
-//! test build. Run one file's tests with its module as the filter:
+//! one test binary: each binary compiles the solver's generic code it uses
+//! anew, so one binary instead of one per file saves much of the test build. Run one file's tests with its module as the filter:
 //! `cargo test --release --test suite -- stability::`.
 
 mod common;
