@@ -71,13 +71,24 @@ fn parse(args: &[String]) -> Result<Option<Options>, cli::Error> {
     Ok(Some(o))
 }
 
-/// Builds the FMU's shared library (release, the product's features only)
-/// and returns its path.
+/// Set (by `cargo xtask test`): [`build_library`] builds the library
+/// together with the `bake` example. An example's dev-dependencies turn on
+/// features of the library's own dependencies (fmi-sys, log, serde_core,
+/// zerocopy, ...), so the library alone and the library under an example are
+/// two builds of it, each overwriting the other's shared library: in a run of
+/// the whole suite, which builds examples between FMUs, the library was
+/// compiled anew at each switch (about 45 s each).
+pub const WITH_EXAMPLES: &str = "MMS_LIBRARY_WITH_EXAMPLES";
+
+/// Builds the FMU's shared library (release, the product's features only;
+/// with [`WITH_EXAMPLES`] set, as the examples build it) and returns its path.
 pub fn build_library(root: &Path) -> Result<PathBuf, String> {
     let target = crate::setup::target_dir(root);
+    let with_examples: &[&str] = if std::env::var_os(WITH_EXAMPLES).is_some() { &["--example", "bake"] } else { &[] };
     let status = Command::new(crate::setup::cargo())
         .current_dir(root)
         .args(["build", "--release", "--lib", "--package", "modal_mass_spring"])
+        .args(with_examples)
         .status()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
     if !status.success() {

@@ -43,28 +43,25 @@ fn parse(args: &[String]) -> Result<Option<Options>, cli::Error> {
 
 pub fn main(args: &[String]) -> Result<(), String> {
     let Some(o) = cli::options(parse(args), USAGE)? else { return Ok(()) };
-    run_with(o.quick, &o.out, &[], &o.study_args)
+    run_with(o.quick, &o.out, &o.study_args)
 }
 
-/// The study with `cargo_args` added to its `cargo run` (`cargo xtask test`
-/// passes its own features, so the example reuses the test build).
-pub fn run(quick: bool, out: &str, cargo_args: &[&str]) -> Result<(), String> {
-    run_with(quick, out, cargo_args, &[])
+/// The study (`cargo xtask test` runs the quick one for pytest).
+pub fn run(quick: bool, out: &str) -> Result<(), String> {
+    run_with(quick, out, &[])
 }
 
-fn run_with(quick: bool, out: &str, cargo_args: &[&str], study_args: &[String]) -> Result<(), String> {
+fn run_with(quick: bool, out: &str, study_args: &[String]) -> Result<(), String> {
     let date = Command::new("date").arg("-u").arg("+%Y-%m-%d").output().ok().and_then(|o| String::from_utf8(o.stdout).ok()).unwrap_or_default();
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|s| s.lines().find(|l| l.starts_with("model name")).map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string()))
         .unwrap_or_else(|| "unknown CPU".into());
     let root = crate::setup::root();
-    // Built, then run: `cargo run` cannot take --workspace, which
-    // `cargo xtask test` passes so that the build reuses the test build.
+    // Built, then run (the binary is run with the study's arguments).
     let status = Command::new(crate::setup::cargo())
         .current_dir(&root)
         .args(["build", "--release", "--example", "report"])
-        .args(cargo_args)
         .status()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
     if !status.success() {

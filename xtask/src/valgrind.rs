@@ -13,7 +13,7 @@ pub const DEFAULT_CYCLES: &str = "12";
 
 pub fn main(args: &[String]) -> Result<(), String> {
     let Some(cycles) = cli::options(parse(args), USAGE)? else { return Ok(()) };
-    run(&cycles, &[])
+    run(&cycles)
 }
 
 const USAGE: &str = "\
@@ -34,9 +34,8 @@ fn parse(args: &[String]) -> Result<Option<String>, cli::Error> {
     Ok(Some(cycles.unwrap_or_else(|| DEFAULT_CYCLES.to_string())))
 }
 
-/// `cycles` cycles under valgrind, the example built with `cargo_args` added
-/// (`cargo xtask test` passes its own features, so the test build is reused).
-pub fn run(cycles: &str, cargo_args: &[&str]) -> Result<(), String> {
+/// `cycles` cycles under valgrind (the example built in the release profile).
+pub fn run(cycles: &str) -> Result<(), String> {
     let root = setup::root();
     if Command::new("valgrind").arg("--version").output().is_err() {
         return Err("valgrind is not installed (cargo xtask setup installs it)".into());
@@ -45,7 +44,6 @@ pub fn run(cycles: &str, cargo_args: &[&str]) -> Result<(), String> {
     let out = Command::new(setup::cargo())
         .current_dir(&root)
         .args(["build", "--release", "--example", "fmi_cycles", "--message-format=json-render-diagnostics"])
-        .args(cargo_args)
         .output()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
     if !out.status.success() {
