@@ -1,6 +1,7 @@
 //! Every integration test of the crate, one module per file of tests/, in
 //! one test binary: each binary compiles the solver's generic code it uses
-//! anew, so one binary instead of one per file saves much of the test build. Run one file's tests with its module as the filter:
+//! anew, so one binary instead of one per file saves much of the test build.
+//! Run one file's tests with its module as the filter:
 //! `cargo test --release --test suite -- stability::`.
 
 mod common;
