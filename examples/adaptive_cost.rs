@@ -1,0 +1,39 @@
+//! The stepping cost of the adaptive reduction beside full space and 16
+//! fixed trained vectors on the canonical cloth N x N: 60 steps of 0.01 s
+//! from the state after set-up, the three runs alternated R times, the
+//! fastest and the median of each (`docs/method.md`, section 10).
+//!
+//! `cargo run --release --example adaptive_cost -- [N] [R]` (30 and 15 by default).
+use modal_mass_spring::canonical_scenes;
+use modal_mass_spring::physics::*;
+use std::time::Instant;
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let nx: usize = args.first().map_or(30, |v| v.parse().unwrap());
+    let reps: usize = args.get(1).map_or(15, |v| v.parse().unwrap());
+    let base = canonical_scenes::cloth(nx, nx);
+    let full = Settings::new(Reduction::Full, Integrator::NewmarkExplicit, 0);
+    let mut trained = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 16);
+    trained.mode_selection = ModeSelection::Trained;
+    let adaptive = Settings::new(Reduction::Adaptive, Integrator::NewmarkExplicit, 2);
+    let mut sims: Vec<_> = [full, trained, adaptive].into_iter().map(|s| base.with_settings(s).simulator().unwrap()).collect();
+    let starts: Vec<_> = sims.iter().map(|s| s.snapshot()).collect();
+    let mut times = vec![Vec::new(); 3];
+    for _ in 0..reps {
+        for (i, s) in sims.iter_mut().enumerate() {
+            s.restore(&starts[i]).unwrap();
+            let t = Instant::now();
+            for _ in 0..60 {
+                s.do_step(0.01).unwrap();
+            }
+            times[i].push(t.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    for (name, t) in ["full", "trained 16", "adaptive"].iter().zip(&mut times) {
+        t.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        println!("{name:12} min {:.3} ms median {:.3} ms", t[0], t[t.len() / 2]);
+    }
+    let st = sims[2].reduction_status();
+    println!("adaptive basis {} directions {} reduced {:.3} estimate {:.4}", st.basis_size, st.error_directions, st.reduced_fraction, st.error_estimate);
+    println!("ratio adaptive / trained (min) {:.2}", times[2][0] / times[1][0]);
+}
