@@ -7,7 +7,8 @@
 //! weights; then (format 8) whether an adaptive part follows and the part:
 //! the mode, e, e', e'' of the error model, the estimate's sums, counts and
 //! schedule, the stretch's counters, its poses, the grown vectors and where
-//! the error model was last linearized.
+//! the error model was last linearized; (format 10) the unseen residual's
+//! share at the last check, among the estimate's sums.
 //! Format 5 has no holders 2 to 4: they are at rest.
 
 use crate::bytes::{put_f64, put_f64s, put_u64, put_u8, Reader};
@@ -59,7 +60,7 @@ fn vectors(r: &mut Reader) -> Result<Vec<Vec<f64>>, String> {
     (0..count).map(|_| r.f64s().map_err(String::from)).collect()
 }
 
-fn adaptive_part(r: &mut Reader) -> Result<Option<Box<AdaptivePart>>, String> {
+fn adaptive_part(r: &mut Reader, format: u32) -> Result<Option<Box<AdaptivePart>>, String> {
     match r.u8()? {
         0 => return Ok(None),
         1 => {}
@@ -71,8 +72,9 @@ fn adaptive_part(r: &mut Reader) -> Result<Option<Box<AdaptivePart>>, String> {
         m => return Err(format!("the adaptive run's mode is {m}, not 0 or 1")),
     };
     let error = [r.f64s()?, r.f64s()?, r.f64s()?];
-    let mut sums = [0.0; 5];
-    for x in &mut sums {
+    // Format 10 adds the unseen share of the last check (0 before: none measured).
+    let mut sums = [0.0; 6];
+    for x in sums.iter_mut().take(if format >= 10 { 6 } else { 5 }) {
         *x = r.f64()?;
     }
     let (mut counts, mut stretch) = ([0; 5], [0; 3]);
@@ -124,6 +126,6 @@ pub fn read(r: &mut Reader, format: u32) -> Result<Snapshot, String> {
         return Err(format!("the simulator state holds arrays of {}, {} and {} values", state.y.len(), state.v.len(), state.a.len()));
     }
     let loads = Loads { gravity, point_load, load_node, anchor, rotation, holders: poses, damping_alpha, damping_beta, mode_weights };
-    let adaptive = if format >= 8 { adaptive_part(r)? } else { None };
+    let adaptive = if format >= 8 { adaptive_part(r, format)? } else { None };
     Ok(Snapshot { state, loads, adaptive })
 }

@@ -323,8 +323,9 @@ pub struct AdaptivePart {
     pub in_full: bool,
     /// e, e', e'' of the error model (free DOFs).
     pub error: [Vec<f64>; 3],
-    /// Σ ‖ê‖²_M, Σ ‖x − x0‖²_M, ‖e‖²_M and Σ m |x − x0|² at the last estimate, the time since it.
-    pub sums: [f64; 5],
+    /// Σ ‖ê‖²_M, Σ ‖x − x0‖²_M, ‖e‖²_M and Σ m |x − x0|² at the last estimate, the time since it,
+    /// and the unseen residual's share (squared) at the last check of it (format 10; 0 before).
+    pub sums: [f64; 6],
     /// Internal steps reduced and in all; the estimate's gap, period and steps since the last.
     pub counts: [u64; 5],
     /// Steps of the stretch in full space, the length it should reach, the next pose slot.

@@ -19,6 +19,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// its ‖e‖² and the motion stand for the `wait` communication steps since the last estimate.
     pub(super) fn estimate(&mut self) -> Result<(), PhysicsError> {
         self.unseen_sq = 0.0;
+        let watching = self.check_gap() < self.period;
         let d = self.reduced.space.scene().dim;
         // The motion from the slot positions the estimate has anyway.
         let mut motion = None;
@@ -38,9 +39,11 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             Estimator::Directions(model) => {
                 let felt = self.reduced.felt_loads();
                 // Once per longest gap between estimates (a pass over every spring,
-                // about 3 full-space steps on cloth 100 x 100).
-                if self.gap >= self.period {
+                // about 3 full-space steps on cloth 100 x 100), and at each
+                // estimate while its last share is near its limit (check_gap).
+                if self.gap >= self.period || watching {
                     self.unseen_sq = unseen_share_sq(&mut self.reduced, model, &mut self.residual);
+                    self.unseen_last = self.unseen_sq;
                 }
                 let space = &self.reduced.space;
                 let scene = space.scene();

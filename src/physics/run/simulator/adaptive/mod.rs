@@ -69,6 +69,11 @@ pub const FALL_BACK: f64 = 0.4;
 pub const UNSEEN_PER_TOLERANCE: f64 = 6.0;
 /// See [`UNSEEN_PER_TOLERANCE`].
 pub const UNSEEN_FLOOR: f64 = 0.15;
+/// Where the unseen share at a check passes this part of its limit, the
+/// next estimate and check come sooner than the longest gap: after the
+/// longest gap times (1 − ρ) / (1 − `UNSEEN_WATCH`), ρ the share over its
+/// limit (at least one step; [`Adaptive::check_gap`]).
+pub const UNSEEN_WATCH: f64 = 0.5;
 /// Communication steps of the first stretch in full space before the run tries to return.
 pub const STRETCH: usize = 4;
 /// The longest stretch, in communication steps, and the most poses a stretch keeps.
@@ -146,8 +151,11 @@ pub struct Adaptive<F: ReducedForce, R: Scheme, X: Scheme> {
     last_error_sq: f64,
     last_motion_sq: f64,
     /// The last estimate's unseen residual, squared, over the load squared
-    /// (0: not measured; see [`UNSEEN_PER_TOLERANCE`]).
+    /// (0: not measured; see [`UNSEEN_PER_TOLERANCE`]), and that of the last
+    /// check that measured it (0: none since set-up or the last fall-back),
+    /// which sets how soon the next check comes ([`Self::check_gap`]).
     unseen_sq: f64,
+    unseen_last: f64,
     /// Slot positions at the start and each slot's mass, for the motion;
     /// Φᵀ M (x* − x0) and ‖x* − x0‖²_M over the free DOFs, for the motion of
     /// a reduced state, ‖Φ q + x* − x0‖²_M = |q|² + 2 qᵀ Φᵀ M (x* − x0) + ‖x* − x0‖²_M.
@@ -241,6 +249,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             last_error_sq: 0.0,
             last_motion_sq: 0.0,
             unseen_sq: 0.0,
+            unseen_last: 0.0,
             start: Vec::new(),
             slot_mass,
             motion_reference: Vec::new(),
@@ -381,6 +390,19 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         self.period = self.period.min(in_time);
     }
 
+    /// The communication steps to the next check of the unseen residual
+    /// while its last share ρ (of its limit) passes [`UNSEEN_WATCH`]:
+    /// max(1, ⌊period (1 − ρ) / (1 − UNSEEN_WATCH)⌋); else none sooner
+    /// than the estimates' own schedule (`u64::MAX`). A share growing
+    /// towards the limit is checked the more often the nearer it is.
+    fn check_gap(&self) -> u64 {
+        let rho = (self.unseen_last / self.unseen_limit_sq()).sqrt();
+        if !(rho > UNSEEN_WATCH) {
+            return u64::MAX;
+        }
+        ((self.period as f64 * (1.0 - rho).max(0.0) / (1.0 - UNSEEN_WATCH)).floor() as u64).max(1)
+    }
+
     /// Estimates from the next step on again 1, 2, 4, ... steps apart (after a change).
     fn estimate_soon(&mut self) {
         self.gap = 1;
@@ -462,6 +484,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         s.copy_frame_from(&self.reduced.state);
         self.full.resume(&self.lifted, true);
         self.in_full = true;
+        self.unseen_last = 0.0;
         self.seen_count = 0;
         self.seen_next = 0;
         self.stretch = 0;

@@ -94,7 +94,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         }
         reduced.resume(&s, true);
         // And the residual there must be one the error directions beside it see.
-        let mut built = None;
+        let (mut built, mut share) = (None, 0.0);
         if let Some(set) = &self.chosen.choice.error_set {
             let mut model = Estimator::directions(&scene, &self.chosen, &basis, set);
             let u = unseen_share_sq(&mut reduced, &mut model, &mut self.residual);
@@ -102,7 +102,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
                 self.failed_return();
                 return Ok(());
             }
-            built = Some(model);
+            (built, share) = (Some(model), u);
         }
         self.carry_error(&basis, built, &left, &left_rate);
         self.rewind = s;
@@ -111,6 +111,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         self.grown = grown;
         self.set_motion_reference();
         self.in_full = false;
+        self.unseen_last = share;
         self.stretch = 0;
         self.estimate_soon();
         self.report_basis();

@@ -93,7 +93,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
         s.adaptive = Some(Box::new(AdaptivePart {
             in_full: self.in_full,
             error: [self.error.e.clone(), self.error.v.clone(), self.error.a.clone()],
-            sums: [self.tally.error_sq, self.tally.motion_sq, self.last_error_sq, self.last_motion_sq, self.since],
+            sums: [self.tally.error_sq, self.tally.motion_sq, self.last_error_sq, self.last_motion_sq, self.since, self.unseen_last],
             counts: [self.tally.reduced_steps, self.tally.steps, self.gap, self.period, self.wait],
             stretch: [self.stretch as u64, self.stretch_target as u64, self.seen_next as u64],
             seen: self.seen().to_vec(),
@@ -182,7 +182,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
         if self.carried.e.len() != n {
             self.carried = ErrorState::zero(n);
         }
-        [self.tally.error_sq, self.tally.motion_sq, self.last_error_sq, self.last_motion_sq, self.since] = part.sums;
+        [self.tally.error_sq, self.tally.motion_sq, self.last_error_sq, self.last_motion_sq, self.since, self.unseen_last] = part.sums;
         [self.tally.reduced_steps, self.tally.steps, self.gap, self.period, self.wait] = part.counts;
         (self.stretch, self.stretch_target, self.seen_next) = (stretch, target, next);
         for (slot, pose) in self.seen.iter_mut().zip(&part.seen) {
@@ -314,7 +314,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             self.lift();
             return self.step_full(h).inspect(|_| self.report_coordinates());
         }
-        let due = self.wait + 1 >= self.gap;
+        let due = self.wait + 1 >= self.gap.min(self.check_gap());
         if due {
             self.spare_error.copy_from(&self.error);
             self.spare_tally = self.tally;
