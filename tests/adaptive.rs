@@ -291,3 +291,26 @@ fn a_snapshot_resumes_the_run_bit_for_bit_in_either_mode() {
     assert!(matches!(sim.restore(&plain), Err(PhysicsError::AdaptiveState { .. })));
     assert_eq!(sim.snapshot(), before);
 }
+
+/// Where cubature forces would pay but the basis and its error directions
+/// are more than a cubature is trained for (cloth 100 x 100 at a tolerance
+/// of 0.003: 28 vectors), a reduced step with exact forces costs what a
+/// full-space step does and the full-space error model's factorization tens
+/// of them: the run goes in full space throughout, and says why.
+#[test]
+fn where_exact_forces_cannot_pay_the_run_is_full_space_throughout() {
+    let base = canonical_scenes::cloth(100, 100);
+    let adaptive = Settings { error_tolerance: 0.003, ..Settings::new(Reduction::Adaptive, Integrator::NewmarkExplicit, 2) };
+    let mut sim = base.with_settings(adaptive).simulator().unwrap();
+    let status = sim.reduction_status();
+    println!("cloth 100 x 100 at 0.003: {} vectors chosen, {:?}", status.chosen_size, status.why_full);
+    assert_eq!(status.why_full, Some(FullThroughout::ExactForces));
+    assert!(!status.reduces);
+    for _ in 0..3 {
+        sim.do_step(H).unwrap();
+    }
+    assert_eq!(sim.reduction_status().reduced_fraction, 0.0);
+    // At the default tolerance the same scene reduces (cubature forces, error directions).
+    let default = base.with_settings(Settings::new(Reduction::Adaptive, Integrator::NewmarkExplicit, 2)).simulator().unwrap();
+    assert_eq!(default.reduction_status().why_full, None);
+}

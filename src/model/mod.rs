@@ -23,7 +23,7 @@ use crate::bytes::Reader;
 use crate::fmi::logging::Logger;
 use crate::fmi::model::{Computed, Model, StepEnd};
 use crate::fmi::variables::{index_of, vr, Causality, VARIABLES};
-use crate::physics::{ModeClasses, Simulator, Snapshot};
+use crate::physics::{FullThroughout, ModeClasses, Simulator, Snapshot};
 use crate::status::{OK, WARNING};
 
 pub use crate::fmi::params::Params;
@@ -130,17 +130,23 @@ impl Model for MassSpring {
                         status.chosen_size,
                         sim.settings().error_tolerance
                     );
-                    if status.reduces {
-                        log.log(OK, &format!("{chosen}, {forces}, {model}"));
-                    } else {
-                        let n = sim.n_dofs();
-                        log.log(
+                    let n = sim.n_dofs();
+                    match status.why_full {
+                        None => log.log(OK, &format!("{chosen}, {forces}, {model}")),
+                        Some(FullThroughout::FewDofs) => log.log(
                             OK,
                             &format!(
                                 "{chosen}; on {n} free DOFs a basis pays with at most one vector per {} of them: full space throughout",
                                 crate::physics::ADAPTIVE_DOFS_PER_VECTOR
                             ),
-                        );
+                        ),
+                        Some(FullThroughout::ExactForces) => log.log(
+                            OK,
+                            &format!(
+                                "{chosen}; with its error directions it passes the {} vectors a cubature is trained for, and with exact forces on {all} springs a reduced step costs what a full-space step does: full space throughout",
+                                crate::physics::ADAPTIVE_JOINT_CUBATURE_MODES
+                            ),
+                        ),
                     }
                 }
                 self.installed(sim);

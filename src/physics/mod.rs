@@ -28,7 +28,9 @@ pub use run::simulator::{
 };
 pub use run::state::{AdaptivePart, Loads, Motion, Pose, Snapshot, State, OTHER_HOLDERS};
 pub use settings::{ForceEvaluation, Integrator, Linearization, ModeSelection, Reduction, Settings, TrainingProgram};
+pub use setup::adaptive_basis::FullThroughout;
 pub use setup::adaptive_basis::DOFS_PER_VECTOR as ADAPTIVE_DOFS_PER_VECTOR;
+pub use setup::adaptive_basis::JOINT_CUBATURE_MODES as ADAPTIVE_JOINT_CUBATURE_MODES;
 pub use setup::grid::{FixedNodes, Grid};
 pub use setup::mode_classes::ModeClasses;
 pub use setup::scene::{Holder, Scene, MAX_HOLDERS};

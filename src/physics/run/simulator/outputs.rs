@@ -350,6 +350,7 @@ impl<S: Readout, I: Scheme> SetUp for Run<S, I> {
             basis_size: kept.unwrap_or(self.space.scene().n_dofs()),
             chosen_size: kept.unwrap_or(self.space.scene().n_dofs()),
             reduces: kept.is_some(),
+            why_full: None,
             error_directions: 0,
             switches: 0,
             last_switch: Switch::None,

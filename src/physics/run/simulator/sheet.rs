@@ -149,6 +149,8 @@ pub struct ReductionStatus {
     /// (an adaptive run on a scene too small for its basis to pay runs in full space throughout).
     pub chosen_size: usize,
     pub reduces: bool,
+    /// Why an adaptive run goes in full space throughout, where it does.
+    pub why_full: Option<crate::physics::setup::adaptive_basis::FullThroughout>,
     /// The error model's directions (an adaptive run with cubature forces), 0 where it works in full space or there is none.
     pub error_directions: usize,
     /// Switches between the reduced model and full space so far (an

@@ -41,6 +41,9 @@ mod unseen;
 use runs::{inner_settings, reduced_run, slot_masses, slot_motion};
 
 use super::{FallBackCause, Reads, Run, SetUp, Steps, Switch};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, MatMut, MatRef, Par};
+
 use crate::physics::error::{Expected, PhysicsError, Quantity};
 use crate::physics::run::error_model::ErrorState;
 use crate::physics::run::frame::dot;
@@ -49,7 +52,7 @@ use crate::physics::run::simulator::estimators::Estimator;
 use crate::physics::run::space::{Constants, Full, Modal, Readout, ReducedForce};
 use crate::physics::run::state::{Loads, State};
 use crate::physics::settings::{Reduction, Settings};
-use crate::physics::setup::adaptive_basis::{Chosen, CAP_FACTOR, DOFS_PER_VECTOR};
+use crate::physics::setup::adaptive_basis::{full_throughout, Chosen, FullThroughout, CAP_FACTOR};
 use crate::physics::setup::modes::ModalBasis;
 use crate::physics::setup::scene::Scene;
 
@@ -130,8 +133,8 @@ pub struct Adaptive<F: ReducedForce, R: Scheme, X: Scheme> {
     in_full: bool,
     /// Internal steps the last communication step took.
     last_steps: usize,
-    /// The basis is small enough to pay ([`DOFS_PER_VECTOR`]): else full space throughout.
-    reduces: bool,
+    /// Why the reduced model cannot pay, if it cannot ([`full_throughout`]): then full space throughout.
+    why_full: Option<FullThroughout>,
     chosen: Chosen,
     /// The vectors grown so far, oldest first.
     grown: Vec<Vec<f64>>,
@@ -234,7 +237,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             full,
             in_full: false,
             last_steps: 0,
-            reduces: n >= DOFS_PER_VECTOR * chosen.data.basis.r,
+            why_full: full_throughout(&scene, &chosen),
             grown: Vec::new(),
             model,
             spare_error: error.clone(),
@@ -282,7 +285,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         run.set_motion_reference();
         run.rewind = run.reduced.state.clone();
         run.kick_q = vec![0.0; run.reduced.space.basis().r];
-        if run.reduces {
+        if run.reduces() {
             run.twin = Some(twin::make_twin(&run.full, settings, loads)?);
         } else {
             run.lift();
@@ -326,7 +329,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     }
 
     /// The coordinates of the state in the reported vectors: the reduced
-    /// run's own, or Φᵀ M u of the full-space state.
+    /// run's own, or Φᵀ M (x − x*) of the full-space state (M (x − x*) into
+    /// the residual's scratch, then faer's matrix-vector product).
     fn report_coordinates(&mut self) {
         let k = self.coordinates.len();
         if !self.in_full {
@@ -340,13 +344,16 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         let point = &self.chosen.data.point;
         let u = &self.full.state.y;
         let rest = &self.full.space.scene().rest;
-        self.coordinates.fill(0.0);
-        for i in 0..u.len() {
-            let mu = mass[i] * (u[i] + rest[i] - point[i]);
-            for (c, p) in self.coordinates.iter_mut().zip(&self.reported.phi[i * k..(i + 1) * k]) {
-                *c += p * mu;
-            }
+        let n = u.len();
+        let mu = &mut self.residual[..n];
+        for (i, m) in mu.iter_mut().enumerate() {
+            *m = mass[i] * (u[i] + rest[i] - point[i]);
         }
+        // Φ row-major n x k is Φᵀ column-major k x n.
+        let phi_t = MatRef::from_column_major_slice(&self.reported.phi, k, n);
+        let out = MatMut::from_column_major_slice_mut(&mut self.coordinates, k, 1);
+        matmul(out, Accum::Replace, phi_t, MatRef::from_column_major_slice(mu, n, 1), 1.0, Par::Seq);
+        crate::physics::vector_unit::clean();
     }
 
     /// Φᵀ M (x* − x0) and ‖x* − x0‖²_M of the reduced run's basis (after set-up and each new basis).
@@ -388,6 +395,11 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         // And at most LONGEST_GAP_SECONDS apart, whatever the step.
         let in_time = ((LONGEST_GAP_SECONDS / h * (1.0 + 1e-9)).floor() as u64).max(1);
         self.period = self.period.min(in_time);
+    }
+
+    /// The reduced model can pay ([`full_throughout`]).
+    fn reduces(&self) -> bool {
+        self.why_full.is_none()
     }
 
     /// The communication steps to the next check of the unseen residual
@@ -493,18 +505,21 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     }
 
     fn step_full(&mut self, h: f64) -> Result<(), PhysicsError> {
-        self.step_full_carrying(h)?;
+        // Whether an error is carried, looked at once a step (a pass over 3 n
+        // values while none is); a run that never reduces never carries one.
+        let carrying = self.reduces() && self.carries_error();
+        self.step_full_carrying(h, carrying)?;
         self.tally.steps += self.full.internal_steps_last as u64;
         self.wait += 1;
         self.since += h;
-        if self.wait >= self.gap || self.carries_error() {
+        if self.wait >= self.gap || carrying {
             // Full space adds no error; the error carried moves on with the
             // twin, which knows it at every step (an estimate costs O(n) here).
             self.update_period(h);
             self.estimate()?;
         }
         self.stretch += 1;
-        if !self.reduces {
+        if !self.reduces() {
             // A run that never returns keeps no poses and no stretch.
             self.stretch = 0;
             return Ok(());

@@ -20,7 +20,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// Grows the basis from the stretch and returns to it if it holds the
     /// state; else the next stretch is twice as long (see the module documentation).
     pub(super) fn try_return(&mut self) -> Result<(), PhysicsError> {
-        if !self.reduces || self.outside_program() {
+        if !self.reduces() || self.outside_program() {
             self.stretch = 0;
             return Ok(());
         }

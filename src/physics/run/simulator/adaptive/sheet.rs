@@ -289,7 +289,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> SetUp for Adaptive<F, R, X> {
             reduced_fraction: self.tally.reduced_fraction(),
             basis_size: if self.in_full { self.reduced.n_dofs() } else { self.reduced.space.basis().r },
             chosen_size: self.chosen.data.basis.r,
-            reduces: self.reduces,
+            reduces: self.reduces(),
+            why_full: self.why_full,
             error_directions: match &self.model {
                 Estimator::Directions(m) => m.directions(),
                 Estimator::Full(_) => 0,

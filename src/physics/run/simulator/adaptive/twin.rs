@@ -70,12 +70,12 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         mass.iter().zip(&self.error.e).map(|(m, e)| m * e * e).sum()
     }
 
-    /// One communication step of `h` in full space with the error carried:
-    /// the twin's step from the state plus e, the run's own, and e the
+    /// One communication step of `h` in full space with the error carried
+    /// (`carrying`, [`Self::carries_error`]): the twin's step from the state plus e, the run's own, and e the
     /// difference. The twin failing leaves e as it was; the run's own
     /// failing leaves the run and e at the step's start.
-    pub(super) fn step_full_carrying(&mut self, h: f64) -> Result<(), PhysicsError> {
-        if !self.carries_error() {
+    pub(super) fn step_full_carrying(&mut self, h: f64, carrying: bool) -> Result<(), PhysicsError> {
+        if !carrying {
             return self.full.do_step(h);
         }
         let twin_moved = self.step_twin(h).is_ok();
