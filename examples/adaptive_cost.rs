@@ -1,7 +1,8 @@
 //! The stepping cost of the adaptive reduction beside full space and 16
-//! fixed trained vectors on the canonical cloth N x N: 60 steps of 0.01 s
-//! from the state after set-up, the three runs alternated R times, the
-//! fastest and the median of each (`docs/method.md`, section 10).
+//! fixed trained vectors (exact forces, and cubature forces) on the
+//! canonical cloth N x N: 60 steps of 0.01 s from the state after set-up,
+//! the four runs alternated R times, the fastest and the median of each
+//! (`docs/method.md`, section 10).
 //!
 //! `cargo run --release --example adaptive_cost -- [N] [R] [sideways]`
 //! (30 and 15 by default; `sideways`: gravity turned fully sideways after
@@ -17,8 +18,9 @@ fn main() {
     let full = Settings::new(Reduction::Full, Integrator::NewmarkExplicit, 0);
     let mut trained = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, 16);
     trained.mode_selection = ModeSelection::Trained;
+    let cubature = Settings { force_evaluation: ForceEvaluation::Cubature, ..trained.clone() };
     let adaptive = Settings::new(Reduction::Adaptive, Integrator::NewmarkExplicit, 2);
-    let mut sims: Vec<_> = [full, trained, adaptive].into_iter().map(|s| base.with_settings(s).simulator().unwrap()).collect();
+    let mut sims: Vec<_> = [full, trained, cubature, adaptive].into_iter().map(|s| base.with_settings(s).simulator().unwrap()).collect();
     if args.get(2).is_some_and(|a| a == "sideways") {
         for s in &mut sims {
             let loads = Loads { gravity: [9.81, 0.0, 0.0], ..s.loads().clone() };
@@ -26,7 +28,7 @@ fn main() {
         }
     }
     let starts: Vec<_> = sims.iter().map(|s| s.snapshot()).collect();
-    let mut times = vec![Vec::new(); 3];
+    let mut times = vec![Vec::new(); 4];
     for _ in 0..reps {
         for (i, s) in sims.iter_mut().enumerate() {
             s.restore(&starts[i]).unwrap();
@@ -37,12 +39,18 @@ fn main() {
             times[i].push(t.elapsed().as_secs_f64() * 1e3);
         }
     }
-    for (name, t) in ["full", "trained 16", "adaptive"].iter().zip(&mut times) {
+    for (name, t) in ["full", "trained 16", "cubature 16", "adaptive"].iter().zip(&mut times) {
         t.sort_by(|a, b| a.partial_cmp(b).unwrap());
         println!("{name:12} min {:.3} ms median {:.3} ms", t[0], t[t.len() / 2]);
     }
-    let st = sims[2].reduction_status();
+    let st = sims[3].reduction_status();
     println!("adaptive basis {} directions {} reduced {:.3} estimate {:.4}", st.basis_size, st.error_directions, st.reduced_fraction, st.error_estimate);
-    println!("ratio adaptive / trained (min) {:.2}", times[2][0] / times[1][0]);
-    println!("internal steps in the last step: full {}, adaptive {}", sims[0].internal_steps_last(), sims[2].internal_steps_last());
+    println!(
+        "adaptive / trained 16 {:.2}, / cubature 16 {:.2}, / full {:.2} (fastest)",
+        times[3][0] / times[1][0],
+        times[3][0] / times[2][0],
+        times[3][0] / times[0][0]
+    );
+    println!("cubature springs {}", sims[2].cubature_springs());
+    println!("internal steps in the last step: full {}, adaptive {}", sims[0].internal_steps_last(), sims[3].internal_steps_last());
 }

@@ -179,6 +179,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
         let [e, v, a] = &part.error;
         self.error = ErrorState { e: e.clone(), v: v.clone(), a: a.clone() };
         self.spare_error = self.error.clone();
+        self.no_error = false;
         if self.carried.e.len() != n {
             self.carried = ErrorState::zero(n);
         }
