@@ -128,9 +128,16 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         self.stretch_target = (2 * self.stretch_target).min(LONGEST_STRETCH);
     }
 
-    /// The modal run on the trained vectors and `grown` under `loads`.
+    /// The modal run on the trained vectors and `grown` under `loads`;
+    /// with none grown, on the set-up's basis itself (a basis made again
+    /// from its own vectors spans the same space, but its vectors may come
+    /// out turned or of opposite sign, and a state's modal coordinates,
+    /// kept in the set-up's basis, would then place the sheet elsewhere).
     pub(super) fn grown_run(&self, grown: &[Vec<f64>], loads: &Loads) -> Result<Run<Modal<F>, R>, PhysicsError> {
         let scene = self.full.space.scene();
+        if grown.is_empty() {
+            return reduced_run(scene, &self.chosen.settings, loads, &self.chosen.data);
+        }
         let vectors: Vec<Vec<f64>> = self.chosen.trained.iter().chain(grown).cloned().collect();
         let data = adaptive_basis::grown_setup(scene, &self.chosen, &vectors)?;
         reduced_run(scene, &self.chosen.settings, loads, &data)
