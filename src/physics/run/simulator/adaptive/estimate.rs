@@ -26,6 +26,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         match &mut self.model {
             // In full space no error is added: the twin moves a carried one on (twin.rs).
             _ if self.in_full => {}
+            Estimator::None => {}
             Estimator::Full(model) => {
                 let felt = self.reduced.felt_loads();
                 let q = &self.reduced.state.y;
@@ -146,7 +147,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// `basis` where the return made it already (it is one pass over every spring).
     pub(super) fn carry_error(&mut self, basis: &ModalBasis, built: Option<DirectionModel>, left: &[f64], left_rate: &[f64]) {
         match &mut self.model {
-            Estimator::Full(_) => {
+            Estimator::Full(_) | Estimator::None => {
                 self.error.e.iter_mut().zip(left).for_each(|(e, l)| *e += l);
                 self.error.v.iter_mut().zip(left_rate).for_each(|(e, l)| *e += l);
                 self.error.a.fill(0.0);

@@ -235,7 +235,11 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         let full_loads = Loads { mode_weights: Vec::new(), ..loads.clone() };
         let full = Run::new(Full::new(scene.clone(), &full_loads, &full_settings)?, &full_settings, &full_loads)?;
         let reduced = reduced_run(&scene, &chosen.settings, loads, &chosen.data)?;
-        let (model, error) = Estimator::new(&scene, &chosen, &chosen.data.basis)?;
+        let why_full = full_throughout(&scene, &chosen);
+        let (model, error) = match why_full {
+            Some(_) => (Estimator::None, ErrorState::zero(scene.n_dofs())),
+            None => Estimator::new(&scene, &chosen, &chosen.data.basis)?,
+        };
         let n = scene.n_dofs();
         let slot_mass = slot_masses(&scene);
         let mut run = Adaptive {
@@ -243,7 +247,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             full,
             in_full: false,
             last_steps: 0,
-            why_full: full_throughout(&scene, &chosen),
+            why_full,
             grown: Vec::new(),
             model,
             spare_error: error.clone(),

@@ -100,7 +100,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
             grown: self.grown.clone(),
             linearized: match &self.model {
                 Estimator::Full(m) => m.linearized_at().to_vec(),
-                Estimator::Directions(_) => Vec::new(),
+                Estimator::Directions(_) | Estimator::None => Vec::new(),
             },
         }));
         s
@@ -147,7 +147,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
         let error_len = match model.as_ref().unwrap_or(&self.model) {
             _ if part.in_full => n,
             Estimator::Directions(m) => m.directions(),
-            Estimator::Full(_) => n,
+            Estimator::Full(_) | Estimator::None => n,
         };
         let slot_values = self.reduced.scene().rest.len();
         if !part.fits(n, error_len) || !(part.linearized.is_empty() || part.linearized.len() == slot_values) {
@@ -294,7 +294,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> SetUp for Adaptive<F, R, X> {
             why_full: self.why_full,
             error_directions: match &self.model {
                 Estimator::Directions(m) => m.directions(),
-                Estimator::Full(_) => 0,
+                Estimator::Full(_) | Estimator::None => 0,
             },
             switches: self.switches,
             last_switch: self.last_switch,
