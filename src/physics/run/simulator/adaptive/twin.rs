@@ -78,10 +78,10 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         if !carrying {
             return self.full.do_step(h);
         }
-        let twin_moved = self.step_twin(h).is_ok();
+        let twin_moved = self.twin_at(false).and_then(|twin| twin.do_step(h)).is_ok();
         self.full.do_step(h)?;
-        if twin_moved {
-            let (t, s) = (&self.twin_state, &self.full.state);
+        if let (true, Some(twin)) = (twin_moved, self.twin.as_deref()) {
+            let (t, s) = (&twin.state, &self.full.state);
             for (i, e) in self.error.e.iter_mut().enumerate() {
                 *e = t.y[i] - s.y[i];
             }
@@ -91,15 +91,6 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             for (i, a) in self.error.a.iter_mut().enumerate() {
                 *a = t.a[i] - s.a[i];
             }
-        }
-        Ok(())
-    }
-
-    /// The twin's step from x + e, x' + e', x'' + e'' at the run's frame, into `twin_state`.
-    fn step_twin(&mut self, h: f64) -> Result<(), PhysicsError> {
-        self.twin_at(false)?.do_step(h)?;
-        if let Some(twin) = &self.twin {
-            self.twin_state.copy_from(&twin.state);
         }
         Ok(())
     }
