@@ -58,8 +58,10 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             std::mem::swap(&mut self.error, &mut self.carried);
         }
         if self.carries_error() && self.twin_at(true).is_ok() {
-            for (i, a) in self.error.a.iter_mut().enumerate() {
-                *a = self.twin_state.a[i] - self.full.state.a[i];
+            if let Some(twin) = self.twin.as_deref() {
+                for (i, a) in self.error.a.iter_mut().enumerate() {
+                    *a = twin.state.a[i] - self.full.state.a[i];
+                }
             }
         }
     }
@@ -97,7 +99,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
 
     /// The twin at the run's state plus the error, under
     /// the host's loads; its accelerations made those of its state with
-    /// `settle`, else x'' + e''. Its state into `twin_state`.
+    /// `settle`, else x'' + e'' (`twin_state` the scratch it is made in).
     fn twin_at(&mut self, settle: bool) -> Result<&mut Run<Full, X>, PhysicsError> {
         let Some(twin) = self.twin.as_deref_mut() else {
             return Err(PhysicsError::AdaptiveState { why: "a run that never reduces carries no error" });
@@ -111,7 +113,6 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         t.v.iter_mut().zip(&e.v).for_each(|(v, e)| *v += e);
         t.a.iter_mut().zip(&e.a).for_each(|(a, e)| *a += e);
         twin.resume(t, settle);
-        t.copy_from(&twin.state);
         Ok(twin)
     }
 }
