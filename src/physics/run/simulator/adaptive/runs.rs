@@ -51,6 +51,11 @@ impl<S: Readout, I: Scheme> Run<S, I> {
     /// those of the state with `settle` (a state from elsewhere), kept otherwise (a state of this run).
     pub(super) fn resume(&mut self, s: &State, settle: bool) {
         self.state.copy_from(s);
+        self.resume_own(settle);
+    }
+
+    /// [`Self::resume`] from the state the run holds now.
+    pub(super) fn resume_own(&mut self, settle: bool) {
         self.apply_loads();
         self.place_holders_now();
         if settle {
@@ -59,5 +64,20 @@ impl<S: Readout, I: Scheme> Run<S, I> {
             self.evaluate_forces();
         }
         self.refresh_outputs();
+    }
+
+    /// Continues from the state the run holds now, set there near where its
+    /// own last step ended (a twin's x + e): the loads and holders as
+    /// [`Self::resume`] places them, the step-size-dependent part of
+    /// `state.a` unknown, but neither the forces at the state (no Newmark
+    /// step reads them, the trigonometric scheme's first step evaluates its
+    /// own) nor the outputs: the step guard weighs the energy the last step
+    /// ended with. The state's coordinates and rates after the next step are
+    /// those [`Self::resume`] gives, bit for bit.
+    pub(super) fn resume_near(&mut self) {
+        self.apply_loads();
+        self.place_holders_now();
+        self.current = false;
+        self.buffers.filter_step = f64::NAN;
     }
 }

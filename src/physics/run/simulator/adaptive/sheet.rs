@@ -180,6 +180,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
         self.error = ErrorState { e: e.clone(), v: v.clone(), a: a.clone() };
         self.spare_error = self.error.clone();
         self.no_error = false;
+        self.twin_fresh = false;
         if self.carried.e.len() != n {
             self.carried = ErrorState::zero(n);
         }

@@ -13,7 +13,13 @@
 //!
 //! S_h the full-space step. The twin takes that step from x + e each
 //! communication step (rebuilt from the run's state and e, so a restored
-//! FMU state goes on bit for bit), and the difference is the new e. It
+//! FMU state goes on bit for bit), and the difference is the new e. Between
+//! its own steps the twin is only set to x + e: its forces are not evaluated
+//! there again, as no Newmark step reads the forces at its start (the
+//! trigonometric scheme evaluates its filtered force there anyway), and its
+//! step guard weighs the energy its own last step ended with (x + e up to
+//! round-off); after a fall-back, a restore or a failed step it is resumed
+//! in full once (forces and energy at x + e). It
 //! follows the growth of an error in a swing the linearized model cannot
 //! (a compressed spring's negative stiffness, which the error model leaves
 //! out, drives it), in part: cloth 30 x 30 with gravity turned sideways at
@@ -21,8 +27,8 @@
 //! estimate reads 0.27 of E (the linearized model's 0.09); the error carried
 //! at the turn is half the true one and points elsewhere, and the swing
 //! grows the true one 50x, the twin's 21x.
-//! Cost: one more full-space step (and a pass over the springs to resume)
-//! per communication step while an error is carried; nothing while none is
+//! Cost: one more full-space step per communication step while an error is
+//! carried (and 6 n additions to set the twin); nothing while none is
 //! (a run that falls back from its first step, as on loads outside its program).
 
 use super::{copy_loads, inner_settings, Adaptive};
@@ -81,6 +87,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             return self.full.do_step(h);
         }
         let twin_moved = self.twin_at(false).and_then(|twin| twin.do_step(h)).is_ok();
+        self.twin_fresh = twin_moved;
         self.full.do_step(h)?;
         if let (true, Some(twin)) = (twin_moved, self.twin.as_deref()) {
             let (t, s) = (&twin.state, &self.full.state);
@@ -99,7 +106,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
 
     /// The twin at the run's state plus the error, under
     /// the host's loads; its accelerations made those of its state with
-    /// `settle`, else x'' + e'' (`twin_state` the scratch it is made in).
+    /// `settle`, else x'' + e''. Right after its own step (`twin_fresh`)
+    /// only its state is set ([`Run::resume_near`]), else it is resumed in full.
     fn twin_at(&mut self, settle: bool) -> Result<&mut Run<Full, X>, PhysicsError> {
         let Some(twin) = self.twin.as_deref_mut() else {
             return Err(PhysicsError::AdaptiveState { why: "a run that never reduces carries no error" });
@@ -107,12 +115,16 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         let host = &self.loads;
         twin.edit_loads(&mut |l| copy_loads(l, host))?;
         let (s, e) = (&self.full.state, &self.error);
-        let t = &mut self.twin_state;
+        let t = &mut twin.state;
         t.copy_from(s);
         t.y.iter_mut().zip(&e.e).for_each(|(y, e)| *y += e);
         t.v.iter_mut().zip(&e.v).for_each(|(v, e)| *v += e);
         t.a.iter_mut().zip(&e.a).for_each(|(a, e)| *a += e);
-        twin.resume(t, settle);
+        if settle || !self.twin_fresh {
+            twin.resume_own(settle);
+        } else {
+            twin.resume_near();
+        }
         Ok(twin)
     }
 }
