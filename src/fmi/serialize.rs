@@ -32,10 +32,12 @@ pub const MAGIC: &[u8; 8] = b"MMSFMU3S";
 /// variables that set them; 7: the variables of a later table (those with
 /// `since_format` 7); 8: an adaptive run's part after the loads; 9: the
 /// variables of a later table again (`since_format` 9); 10: the unseen
-/// residual's share at the last check in the adaptive part. Formats 5 to 9 are still read: the holders 2 to 4 of
+/// residual's share at the last check in the adaptive part; 11: in the
+/// adaptive part, the state of the twin that carries the error in full
+/// space instead of the error (a flag after the mode). Formats 5 to 10 are still read: the holders 2 to 4 of
 /// format 5 are at rest, the variables a format lacks take their start
 /// values, and an adaptive part before format 10 has measured no share.
-pub const VERSION: u32 = 10;
+pub const VERSION: u32 = 11;
 /// The oldest format read.
 pub const OLDEST: u32 = 5;
 /// Bytes before the payload.

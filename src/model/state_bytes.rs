@@ -8,7 +8,9 @@
 //! the mode, e, e', e'' of the error model, the estimate's sums, counts and
 //! schedule, the stretch's counters, its poses, the grown vectors and where
 //! the error model was last linearized; (format 10) the unseen residual's
-//! share at the last check, among the estimate's sums.
+//! share at the last check, among the estimate's sums; (format 11) after
+//! the mode, whether the error's place holds the state of the twin that
+//! goes on beside the run in full space (its y, y', y'') instead of e.
 //! Format 5 has no holders 2 to 4: they are at rest.
 
 use crate::bytes::{put_f64, put_f64s, put_u64, put_u8, Reader};
@@ -41,6 +43,7 @@ pub fn write(snap: &Snapshot, p: &mut Vec<u8>) {
     };
     put_u8(p, 1);
     put_u8(p, u8::from(a.in_full));
+    put_u8(p, u8::from(a.twin));
     a.error.iter().for_each(|e| put_f64s(p, e));
     a.sums.iter().for_each(|x| put_f64(p, *x));
     a.counts.iter().chain(&a.stretch).for_each(|c| put_u64(p, *c));
@@ -71,6 +74,12 @@ fn adaptive_part(r: &mut Reader, format: u32) -> Result<Option<Box<AdaptivePart>
         1 => true,
         m => return Err(format!("the adaptive run's mode is {m}, not 0 or 1")),
     };
+    // Format 11 says whether the error's place holds the twin's state.
+    let twin = match if format >= 11 { r.u8()? } else { 0 } {
+        0 => false,
+        1 => true,
+        t => return Err(format!("the adaptive part's twin flag is {t}, not 0 or 1")),
+    };
     let error = [r.f64s()?, r.f64s()?, r.f64s()?];
     // Format 10 adds the unseen share of the last check (0 before: none measured).
     let mut sums = [0.0; 6];
@@ -82,7 +91,7 @@ fn adaptive_part(r: &mut Reader, format: u32) -> Result<Option<Box<AdaptivePart>
         *c = r.u64()?;
     }
     let (seen, grown, linearized) = (vectors(r)?, vectors(r)?, r.f64s()?);
-    Ok(Some(Box::new(AdaptivePart { in_full, error, sums, counts, stretch, seen, grown, linearized })))
+    Ok(Some(Box::new(AdaptivePart { in_full, twin, error, sums, counts, stretch, seen, grown, linearized })))
 }
 
 fn vector(r: &mut Reader) -> Result<[f64; 3], String> {

@@ -321,7 +321,10 @@ pub struct Snapshot {
 #[derive(Clone, Debug, PartialEq)]
 pub struct AdaptivePart {
     pub in_full: bool,
-    /// e, e', e'' of the error model (free DOFs).
+    /// `error` holds the state of the twin that goes on beside the run in
+    /// full space (its y, y', y''; format 11), not e.
+    pub twin: bool,
+    /// e, e', e'' of the error model (free DOFs), or the twin's y, y', y''.
     pub error: [Vec<f64>; 3],
     /// Σ ‖ê‖²_M, Σ ‖x − x0‖²_M, ‖e‖²_M and Σ m |x − x0|² at the last estimate, the time since it,
     /// and the unseen residual's share (squared) at the last check of it (format 10; 0 before).

@@ -178,9 +178,9 @@ pub struct Adaptive<F: ReducedForce, R: Scheme, X: Scheme> {
     /// reduces) and its state ([`twin`]); in error directions, the error
     /// over the free DOFs while in full space, or the one in directions.
     twin: Option<Box<Run<Full, X>>>,
-    /// The twin's last step went well and nothing was restored or lifted
-    /// since: its forces and energy are those near x + e ([`twin`]).
-    twin_fresh: bool,
+    /// The twin goes on beside the run in full space from its own state,
+    /// and e is its distance to the run, not kept in `error` ([`twin`]).
+    twin_live: bool,
     carried: ErrorState,
     /// In full space, a look found no error carried: none comes back there
     /// (the twin from x + 0 is the run), so the next looks are skipped
@@ -276,7 +276,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             lifted: State::at_rest(n),
             rewind: State::at_rest(0),
             twin: None,
-            twin_fresh: false,
+            twin_live: false,
             carried: ErrorState::zero(n),
             no_error: false,
             kick_q: Vec::new(),
@@ -518,7 +518,6 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         self.seen_next = 0;
         self.stretch = 0;
         self.estimate_soon();
-        self.twin_fresh = false;
         self.error_into_full();
         self.no_error = false;
     }

@@ -104,6 +104,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             }
             (built, share) = (Some(model), u);
         }
+        self.error_from_twin();
+        self.twin_live = false;
         self.carry_error(&basis, built, &left, &left_rate);
         self.rewind = s;
         self.reduced = reduced;

@@ -65,19 +65,4 @@ impl<S: Readout, I: Scheme> Run<S, I> {
         }
         self.refresh_outputs();
     }
-
-    /// Continues from the state the run holds now, set there near where its
-    /// own last step ended (a twin's x + e): the loads and holders as
-    /// [`Self::resume`] places them, the step-size-dependent part of
-    /// `state.a` unknown, but neither the forces at the state (no Newmark
-    /// step reads them, the trigonometric scheme's first step evaluates its
-    /// own) nor the outputs: the step guard weighs the energy the last step
-    /// ended with. The state's coordinates and rates after the next step are
-    /// those [`Self::resume`] gives, bit for bit.
-    pub(super) fn resume_near(&mut self) {
-        self.apply_loads();
-        self.place_holders_now();
-        self.current = false;
-        self.buffers.filter_step = f64::NAN;
-    }
 }

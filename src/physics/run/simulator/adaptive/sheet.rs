@@ -90,9 +90,15 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
     fn snapshot(&self) -> Snapshot {
         let mut s = self.active().snapshot();
         s.loads = self.loads.clone();
+        // With the twin going on, its own state (e is its distance to the run).
+        let error = match self.live_twin() {
+            Some(t) => [t.state.y.clone(), t.state.v.clone(), t.state.a.clone()],
+            None => [self.error.e.clone(), self.error.v.clone(), self.error.a.clone()],
+        };
         s.adaptive = Some(Box::new(AdaptivePart {
             in_full: self.in_full,
-            error: [self.error.e.clone(), self.error.v.clone(), self.error.a.clone()],
+            twin: self.live_twin().is_some(),
+            error,
             sums: [self.tally.error_sq, self.tally.motion_sq, self.last_error_sq, self.last_motion_sq, self.since, self.unseen_last],
             counts: [self.tally.reduced_steps, self.tally.steps, self.gap, self.period, self.wait],
             stretch: [self.stretch as u64, self.stretch_target as u64, self.seen_next as u64],
@@ -129,6 +135,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
             || part.counts[0] > part.counts[1]
             || self.chosen.trained.len() + part.grown.len() > cap
             || part.sums.iter().any(|x| *x < 0.0)
+            || (part.twin && !(part.in_full && self.reduces()))
         {
             return refuse("its adaptive part does not fit this scene (corrupt or of another set-up)");
         }
@@ -180,7 +187,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
         self.error = ErrorState { e: e.clone(), v: v.clone(), a: a.clone() };
         self.spare_error = self.error.clone();
         self.no_error = false;
-        self.twin_fresh = false;
+        self.twin_live = false;
         if self.carried.e.len() != n {
             self.carried = ErrorState::zero(n);
         }
@@ -193,6 +200,11 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
         self.seen_count = part.seen.len();
         copy_loads(&mut self.loads, &s.loads);
         self.loads.mode_weights.clone_from(&s.loads.mode_weights);
+        if part.twin {
+            // The loads the run accepted, and a twin of the fitting length: it cannot fail here.
+            self.restore_twin(&part.error)?;
+            self.spare_error = self.error.clone();
+        }
         self.report_coordinates();
         Ok(())
     }
@@ -355,6 +367,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         self.lift();
         if let Err(e) = self.step_full(h) {
             self.in_full = false;
+            self.twin_live = false;
             return Err(e);
         }
         self.report_coordinates();
