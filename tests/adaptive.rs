@@ -362,3 +362,41 @@ fn a_run_restored_to_before_its_basis_grew_runs_again_bit_for_bit() {
         assert!(a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits()), "step {} after the restore differs", k + 1);
     }
 }
+
+/// A state of format 10 or older held e in full space, not the twin's own
+/// state: restored, the twin is made again at the run's state plus e, and
+/// the run goes on as it did (its positions bit for bit: the twin moves the
+/// estimate only), its estimate the same to round-off. A twin's state in a
+/// reduced mode is refused, and the run keeps its own.
+#[test]
+fn a_state_that_holds_e_in_full_space_goes_on_with_its_twin_made_again() {
+    let at = 30;
+    let (original, mut snapshots, sizes) = positions_under(shaken, None, &[at], STEPS, Integrator::NewmarkExplicit);
+    assert_eq!(sizes, [3 * 30 * 29], "the run is in full space at step {at}");
+    let mut s = snapshots.remove(0);
+    let part = s.adaptive.as_deref_mut().unwrap();
+    assert!(part.twin, "the state holds the twin's own state");
+    // e = the twin's state less the run's, as format 10 held it.
+    let run = [&s.state.y, &s.state.v, &s.state.a];
+    for (e, x) in part.error.iter_mut().zip(run) {
+        e.iter_mut().zip(x).for_each(|(e, x)| *e -= x);
+    }
+    part.twin = false;
+    let (resumed, _, _) = positions_under(shaken, Some((&s, at)), &[], STEPS, Integrator::NewmarkExplicit);
+    for (j, (a, b)) in resumed.iter().zip(&original[at..]).enumerate() {
+        let (n, ea, eb) = (a.len() - 1, a[a.len() - 1], b[b.len() - 1]);
+        assert!(a[..n].iter().zip(&b[..n]).all(|(x, y)| x.to_bits() == y.to_bits()), "step {} after the restore: the positions differ", j + 1);
+        assert!((ea - eb).abs() <= 1e-9 * eb.abs(), "step {}: estimate {ea} against {eb}", j + 1);
+    }
+    // The twin's own state is refused for a reduced run.
+    let (_, mut reduced, sizes) = positions_under(shaken, None, &[1], 2, Integrator::NewmarkExplicit);
+    assert!(sizes[0] < 3 * 30 * 29, "the run is reduced at step 1");
+    reduced[0].adaptive.as_deref_mut().unwrap().twin = true;
+    let mut base = canonical_scenes::cloth(30, 30);
+    base.loads.damping_alpha = 0.0;
+    base.loads.damping_beta = 0.0;
+    let mut sim = base.with_settings(Settings::new(Reduction::Adaptive, Integrator::NewmarkExplicit, 2)).simulator().unwrap();
+    let before = sim.snapshot();
+    assert!(matches!(sim.restore(&reduced[0]), Err(PhysicsError::AdaptiveState { .. })));
+    assert_eq!(sim.snapshot(), before);
+}
