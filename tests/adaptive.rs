@@ -400,3 +400,46 @@ fn a_state_that_holds_e_in_full_space_goes_on_with_its_twin_made_again() {
     assert!(matches!(sim.restore(&reduced[0]), Err(PhysicsError::AdaptiveState { .. })));
     assert_eq!(sim.snapshot(), before);
 }
+
+/// errorTolerance is tunable: a tighter one set mid-run makes the run fall
+/// back where the one it was set up for keeps it reduced (the basis stays
+/// the one chosen at set-up); a snapshot keeps the tolerance in effect, and
+/// a tolerance that is not positive is refused, the loads kept.
+#[test]
+fn a_tolerance_set_mid_run_sets_when_the_run_falls_back() {
+    let mut base = canonical_scenes::cloth(30, 30);
+    base.loads.damping_alpha = 0.0;
+    base.loads.damping_beta = 0.0;
+    let settings = Settings { error_tolerance: 0.01, ..Settings::new(Reduction::Adaptive, Integrator::NewmarkExplicit, 2) };
+    let run = |tighter: Option<f64>| {
+        let mut sim = base.with_settings(settings.clone()).simulator().unwrap();
+        let mut snapshot = None;
+        for k in 0..STEPS {
+            if k == 20 {
+                let l = Loads { error_tolerance: tighter, ..sim.loads().clone() };
+                sim.set_loads(&l).unwrap();
+                snapshot = Some(sim.snapshot());
+            }
+            sim.do_step(H).unwrap();
+        }
+        (sim, snapshot.unwrap())
+    };
+    let (kept, _) = run(None);
+    let (tight, at_20) = run(Some(1e-4));
+    let (kept, tight) = (kept.reduction_status(), tight.reduction_status());
+    println!("reduced share: {:.3} at the set-up tolerance, {:.3} with 1e-4 from 0.2 s", kept.reduced_fraction, tight.reduced_fraction);
+    assert_eq!(kept.reduced_fraction, 1.0);
+    assert!(tight.reduced_fraction < 0.5, "a tolerance of 1e-4 from 0.2 s left {} of the steps reduced", tight.reduced_fraction);
+    assert_eq!(at_20.loads.error_tolerance, Some(1e-4));
+    // Restored into a run set up for 0.01, the state's tolerance goes on.
+    let mut sim = base.with_settings(settings.clone()).simulator().unwrap();
+    sim.restore(&at_20).unwrap();
+    for _ in 20..STEPS {
+        sim.do_step(H).unwrap();
+    }
+    assert_eq!(sim.reduction_status().reduced_fraction, tight.reduced_fraction);
+    let before = sim.snapshot();
+    let bad = Loads { error_tolerance: Some(-0.01), ..sim.loads().clone() };
+    assert!(matches!(sim.set_loads(&bad), Err(PhysicsError::Invalid { quantity: Quantity::ErrorTolerance, .. })));
+    assert_eq!(sim.snapshot(), before);
+}

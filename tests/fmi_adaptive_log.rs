@@ -83,3 +83,26 @@ fn gravity_outside_the_program_is_logged_as_the_cause() {
     f.run(5, 0.01);
     assert!(switches(&f).is_empty());
 }
+
+#[test]
+fn a_tolerance_tightened_between_steps_makes_the_run_fall_back() {
+    let p = adaptive(12, 0.1, 1);
+    let f = Fmu::with_resources("tightened", Some(&resources("switch-tightened", &p, None)));
+    f.init();
+    f.run(3, 0.01);
+    assert!(switches(&f).is_empty(), "inside the program at 0.1: no switch");
+    // Out of its range: refused, the value kept.
+    assert_eq!(f.set_f64(vr::ERROR_TOLERANCE, &[0.0]), ERROR);
+    assert_eq!(f.f64s(vr::ERROR_TOLERANCE, 1), [0.1]);
+    assert_eq!(f.set_f64(vr::ERROR_TOLERANCE, &[1e-4]), OK);
+    let mut logged = Vec::new();
+    for _ in 0..10 {
+        let t = f.time();
+        assert_eq!(f.step(t, 0.01), OK);
+        logged.extend(switches(&f));
+        if !logged.is_empty() {
+            break;
+        }
+    }
+    assert!(logged.first().is_some_and(|m| m.contains("estimated error of the state")), "a fall-back on the estimate within 10 steps: {logged:?}");
+}

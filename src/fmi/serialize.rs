@@ -34,7 +34,8 @@ pub const MAGIC: &[u8; 8] = b"MMSFMU3S";
 /// variables of a later table again (`since_format` 9); 10: the unseen
 /// residual's share at the last check in the adaptive part; 11: in the
 /// adaptive part, the state of the twin that carries the error in full
-/// space instead of the error (a flag after the mode). Formats 5 to 10 are still read: the holders 2 to 4 of
+/// space instead of the error (a flag after the mode), and the error
+/// tolerance in effect among the loads (the model's tolerance became tunable). Formats 5 to 10 are still read: the holders 2 to 4 of
 /// format 5 are at rest, the variables a format lacks take their start
 /// values, and an adaptive part before format 10 has measured no share.
 pub const VERSION: u32 = 11;

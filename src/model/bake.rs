@@ -8,8 +8,8 @@
 //! whose values differ (or a file that is corrupt or from another build)
 //! computes the set-up and logs why.
 //!
-//! The key is every structural and fixed parameter (errorTolerance among
-//! them), the set-up gravity and the set-up point load,
+//! The key is every structural and fixed parameter, the set-up gravity,
+//! the set-up point load and errorTolerance at set-up (tunable, it sizes the basis),
 //! except those set-up does not read ([`NOT_READ_BY_SETUP`]). File layout
 //! (little-endian): magic `MMSBAKE1`, the crate version (u32 length +
 //! bytes), the key (u32 count, then per variable u32 value reference, u32
@@ -28,8 +28,9 @@ const MAGIC: &[u8; 8] = b"MMSBAKE1";
 /// (a twin's start moves the state after it).
 const NOT_READ_BY_SETUP: &[u32] = &[vr::INTEGRATOR, vr::MAX_INTERNAL_STEP, vr::START_OFFSET, vr::START_SEED];
 
-/// Tunable parameters and inputs whose values at set-up the basis reads.
-const SETUP_LOADS: &[u32] = &[vr::GRAVITY, vr::LOAD_X, vr::LOAD_Y, vr::LOAD_Z];
+/// Tunable parameters and inputs whose values at set-up the basis reads
+/// (errorTolerance sizes the basis).
+const SETUP_LOADS: &[u32] = &[vr::GRAVITY, vr::LOAD_X, vr::LOAD_Y, vr::LOAD_Z, vr::ERROR_TOLERANCE];
 
 /// The values the set-up depends on, by value reference.
 fn key(p: &Params) -> Vec<(u32, Vec<f64>)> {

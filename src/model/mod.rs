@@ -179,8 +179,16 @@ impl Model for MassSpring {
         if running {
             // Only tunables and inputs get here; they act from the next step on.
             let sim = self.sim.as_mut().expect("Step Mode has a simulator");
-            // Written where the physics reads them, all or nothing.
-            sim.edit_loads(&mut |loads| p.fill_loads(loads)).map_err(|e| messages::describe(&e, p))?;
+            // Written where the physics reads them, all or nothing; errorTolerance
+            // once set between steps (at set-up it chose the basis, and the run follows it).
+            let tolerance = vrs.contains(&vr::ERROR_TOLERANCE).then(|| p.scalar(vr::ERROR_TOLERANCE));
+            sim.edit_loads(&mut |loads| {
+                p.fill_loads(loads);
+                if tolerance.is_some() {
+                    loads.error_tolerance = tolerance;
+                }
+            })
+            .map_err(|e| messages::describe(&e, p))?;
             // New parameters (gravity turned sideways, weights, damping) are checked after the
             // next step; the inputs a master sets every step (the point load, the holder) are not,
             // or the check would run after every step of a coupled run.

@@ -4,7 +4,8 @@
 //! its displacement, velocity, rotation vector and spin; then the loads:
 //! gravity, point load, load node, anchor and holder targets, (format 6)
 //! per holder 2 to 4 its displacement and rotation targets, damping,
-//! weights; then (format 8) whether an adaptive part follows and the part:
+//! weights, (format 11) the error tolerance in effect (NaN: the one set
+//! up); then (format 8) whether an adaptive part follows and the part:
 //! the mode, e, e', e'' of the error model, the estimate's sums, counts and
 //! schedule, the stretch's counters, its poses, the grown vectors and where
 //! the error model was last linearized; (format 10) the unseen residual's
@@ -37,6 +38,8 @@ pub fn write(snap: &Snapshot, p: &mut Vec<u8>) {
     put_f64(p, l.damping_alpha);
     put_f64(p, l.damping_beta);
     put_f64s(p, &l.mode_weights);
+    // Format 11: the error tolerance in effect (NaN: the one set up).
+    put_f64(p, l.error_tolerance.unwrap_or(f64::NAN));
     let Some(a) = &snap.adaptive else {
         put_u8(p, 0);
         return;
@@ -128,13 +131,14 @@ pub fn read(r: &mut Reader, format: u32) -> Result<Snapshot, String> {
     let damping_alpha = r.f64()?;
     let damping_beta = r.f64()?;
     let mode_weights = r.f64s()?;
+    let error_tolerance = if format >= 11 { Some(r.f64()?).filter(|t| !t.is_nan()) } else { None };
     if !(state.is_finite() && state.time >= 0.0) {
         return Err("the simulator state holds a negative or non-finite time or non-finite values".into());
     }
     if state.v.len() != state.y.len() || state.a.len() != state.y.len() {
         return Err(format!("the simulator state holds arrays of {}, {} and {} values", state.y.len(), state.v.len(), state.a.len()));
     }
-    let loads = Loads { gravity, point_load, load_node, anchor, rotation, holders: poses, damping_alpha, damping_beta, mode_weights };
+    let loads = Loads { gravity, point_load, load_node, anchor, rotation, holders: poses, damping_alpha, damping_beta, mode_weights, error_tolerance };
     let adaptive = if format >= 8 { adaptive_part(r, format)? } else { None };
     Ok(Snapshot { state, loads, adaptive })
 }

@@ -31,7 +31,7 @@ INTERFACE = {
     "linearization": ("Enumeration", "parameter", "fixed"),
     "forceEvaluation": ("Enumeration", "parameter", "fixed"),
     "cubatureTolerance": ("Float64", "parameter", "fixed"),
-    "errorTolerance": ("Float64", "parameter", "fixed"),
+    "errorTolerance": ("Float64", "parameter", "tunable"),
     "forceResidualLimit": ("Float64", "parameter", "tunable"),
     "gravity": ("Float64", "parameter", "tunable"),
     "dampingAlpha": ("Float64", "parameter", "tunable"),

@@ -9,7 +9,7 @@
 //!   simulator's backup before a step and the FMU state are snapshots.
 
 use crate::options::start;
-use crate::physics::error::{non_negative, Expected, HolderProblem, PhysicsError, Quantity};
+use crate::physics::error::{non_negative, positive, Expected, HolderProblem, PhysicsError, Quantity};
 use crate::physics::setup::scene::{Scene, MAX_HOLDERS};
 
 /// Holders that move on their own, beside the first (whose frame the
@@ -186,6 +186,11 @@ pub struct Loads {
     /// Gain w_i per mode (`docs/method.md`, section 3); one per mode kept
     /// or reported, used by the modal space only.
     pub mode_weights: Vec<f64>,
+    /// The error E an adaptive run may reach from the next step on (when
+    /// it falls back and returns, `docs/method.md`, section 10); `None`: the
+    /// one it was set up for ([`crate::physics::Settings::error_tolerance`],
+    /// which chose its basis). Other runs do not read it.
+    pub error_tolerance: Option<f64>,
 }
 
 impl Clone for Loads {
@@ -215,6 +220,7 @@ impl Loads {
             damping_alpha: start::DAMPING_ALPHA,
             damping_beta: start::DAMPING_BETA,
             mode_weights: vec![1.0; n_modes],
+            error_tolerance: None,
         }
     }
 
@@ -298,6 +304,9 @@ impl Loads {
         }
         non_negative(Quantity::DampingAlpha, self.damping_alpha)?;
         non_negative(Quantity::DampingBeta, self.damping_beta)?;
+        if let Some(t) = self.error_tolerance {
+            positive(Quantity::ErrorTolerance, t)?;
+        }
         if self.mode_weights.len() != n_modes {
             return Err(PhysicsError::Length { quantity: Quantity::ModeWeights, len: self.mode_weights.len(), expected: n_modes });
         }

@@ -469,9 +469,15 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         m > 0.0 && (m0 == 0.0 || m > (1.0 + t.scale) * (1.0 + slack) * m0 || angle(&p0, &p) > 1e-6)
     }
 
+    /// The error E the run may reach now: the one the host's loads give,
+    /// else the one it was set up for, which chose its basis.
+    fn tolerance(&self) -> f64 {
+        self.loads.error_tolerance.unwrap_or(self.settings.error_tolerance)
+    }
+
     /// The square of the unseen residual's limit ([`UNSEEN_PER_TOLERANCE`], [`UNSEEN_FLOOR`]).
     fn unseen_limit_sq(&self) -> f64 {
-        UNSEEN_FLOOR.max(UNSEEN_PER_TOLERANCE * self.settings.error_tolerance).powi(2)
+        UNSEEN_FLOOR.max(UNSEEN_PER_TOLERANCE * self.tolerance()).powi(2)
     }
 
     /// Why the last estimate makes the run fall back, if it does: the
@@ -483,7 +489,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             return Some(FallBackCause::Unseen { share: self.unseen_sq.sqrt(), limit: limit_sq.sqrt() });
         }
         let motion = self.last_motion_sq.max(self.chosen.choice.motion_scale.powi(2));
-        let limit = FALL_BACK * self.settings.error_tolerance;
+        let limit = FALL_BACK * self.tolerance();
         (!(self.last_error_sq <= limit.powi(2) * motion)).then(|| FallBackCause::Error { estimate: (self.last_error_sq / motion).sqrt(), limit })
     }
 

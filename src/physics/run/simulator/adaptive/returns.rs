@@ -54,7 +54,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         // than round-off (SPAN_SLACK), then on the basis made.
         let mass = &scene.dof_mass;
         let motion = self.motion_sq().max(self.chosen.choice.motion_scale.powi(2));
-        let share_sq = (PROJECTION_SHARE * self.settings.error_tolerance).powi(2);
+        let share_sq = (PROJECTION_SHARE * self.tolerance()).powi(2);
         let v = &self.full.state.v;
         let speed: f64 = (0..v.len()).map(|i| mass[i] * v[i] * v[i]).sum();
         let holds = |left: &dyn Fn(&[f64]) -> f64, slack: f64| -> bool {

@@ -200,6 +200,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
         self.seen_count = part.seen.len();
         copy_loads(&mut self.loads, &s.loads);
         self.loads.mode_weights.clone_from(&s.loads.mode_weights);
+        self.loads.error_tolerance = s.loads.error_tolerance;
         if part.twin {
             // The loads the run accepted, and a twin of the fitting length: it cannot fail here.
             self.restore_twin(&part.error)?;
