@@ -184,11 +184,15 @@ def test_bad_tunable_values_are_refused(new_instance):
     inst.initialize()
     inst.step(0.01, 5)
     x = inst.positions()
-    for name, bad in (("modeWeights", [-1.0, 1.0]), ("dampingAlpha", [-1.0]), ("dampingBeta", [-0.5])):
+    bad_values = (("modeWeights", [-1.0, 1.0]), ("dampingAlpha", [-1.0]), ("dampingBeta", [-0.5]), ("errorTolerance", [0.0]))
+    for name, bad in bad_values:
         with pytest.raises(FMICallException):
             inst.set_f64(name, bad)
     np.testing.assert_array_equal(inst.f64("modeWeights", 2), [1.0, 1.0])
     assert inst.f64s("dampingAlpha") == 0.0
+    assert inst.f64s("errorTolerance") == 0.01
+    inst.set_f64("errorTolerance", [0.03])  # tunable: accepted between steps
+    assert inst.f64s("errorTolerance") == 0.03
     with pytest.raises(FMICallException):
         inst.set_f64("gravity", [0.0, -9.81])  # 3 components
     inst.step(0.01)
