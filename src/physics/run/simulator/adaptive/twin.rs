@@ -54,9 +54,9 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
 
     /// On a fall-back, after the run took the lifted state: the error
     /// carried, over the free DOFs (in error directions, Ψ z and Ψ z'), and
-    /// e'' = x''(x + e, x' + e') − x''(x, x'), both accelerations made the
-    /// same way, so the twin's steps start as the run's do; the twin goes on
-    /// from there.
+    /// the twin at x + e, x' + e', its accelerations made as the run's are,
+    /// so its steps start as the run's do; the twin goes on from there (e
+    /// is then their distance, formed where it is needed).
     pub(super) fn error_into_full(&mut self) {
         self.twin_live = false;
         if let Estimator::Directions(m) = &self.model {
@@ -70,14 +70,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             // The error in directions is kept in `carried` until the return.
             std::mem::swap(&mut self.error, &mut self.carried);
         }
-        if self.carries_error() && self.twin_at(true).is_ok() {
-            if let Some(twin) = self.twin.as_deref() {
-                for (i, a) in self.error.a.iter_mut().enumerate() {
-                    *a = twin.state.a[i] - self.full.state.a[i];
-                }
-                self.twin_live = true;
-            }
-        }
+        self.twin_live = self.carries_error() && self.twin_at(true).is_ok();
     }
 
     /// ‖e‖²_M over the free DOFs (the error in full space, whatever the
