@@ -4,7 +4,7 @@
 //! (`docs/method.md`, section 3), each without and with the static correction. One line per
 //! case.
 //!
-//! cargo run --release --example setup_vs_mesh -- [n...] [--modes r] [--lowest | --load | --trained] [--no-correction | --only-correction]
+//! cargo run --release --example setup_vs_mesh -- [n...] [--modes r] [--lowest | --load | --trained] [--no-correction | --only-correction] [--cubature]
 //!
 //! Columns: `basis_s` is `basis::build` on its own (assembly of K, the
 //! factorization of K − σM, the eigen or Ritz solution, Rayleigh–Ritz),
@@ -13,24 +13,27 @@
 //! `setup_s` the whole simulator set-up on the same scene, which builds the
 //! basis again; `other_s` = setup_s − basis_s, the rest of the set-up (the
 //! force model, the step-size bound, the first outputs). `omega_1` is the
-//! lowest kept angular frequency, to tell the cases apart.
+//! lowest kept angular frequency, to tell the cases apart. With
+//! `--cubature` the set-up trains a cubature for the forces (section 4),
+//! which `other_s` then holds.
 
 use std::time::Instant;
 
 use modal_mass_spring::canonical_scenes;
 use modal_mass_spring::physics::setup::{basis, trained_basis};
-use modal_mass_spring::physics::{Integrator, ModeSelection, Reduction, Settings, Simulator};
+use modal_mass_spring::physics::{ForceEvaluation, Integrator, ModeSelection, Reduction, Settings, Simulator};
 
 struct Args {
     sizes: Vec<usize>,
     modes: usize,
     corrections: Vec<bool>,
     selections: Vec<ModeSelection>,
+    cubature: bool,
 }
 
 fn parse_args() -> Result<Args, lexopt::Error> {
     use lexopt::prelude::*;
-    let mut args = Args { sizes: Vec::new(), modes: 30, corrections: vec![false, true], selections: ModeSelection::ALL.to_vec() };
+    let mut args = Args { sizes: Vec::new(), modes: 30, corrections: vec![false, true], selections: ModeSelection::ALL.to_vec(), cubature: false };
     let mut parser = lexopt::Parser::from_env();
     while let Some(arg) = parser.next()? {
         match arg {
@@ -40,6 +43,7 @@ fn parse_args() -> Result<Args, lexopt::Error> {
             Long("lowest") => args.selections = vec![ModeSelection::Lowest],
             Long("load") => args.selections = vec![ModeSelection::Load],
             Long("trained") => args.selections = vec![ModeSelection::Trained],
+            Long("cubature") => args.cubature = true,
             Value(v) => args.sizes.push(v.parse()?),
             _ => return Err(arg.unexpected()),
         }
@@ -51,26 +55,30 @@ fn parse_args() -> Result<Args, lexopt::Error> {
 }
 
 /// The solver settings of every case.
-fn solver(modes: usize, selection: ModeSelection, static_correction: bool) -> Settings {
+fn solver(modes: usize, selection: ModeSelection, static_correction: bool, cubature: bool) -> Settings {
     let mut solver = Settings::new(Reduction::Modal, Integrator::NewmarkExplicit, modes);
     solver.mode_selection = selection;
     solver.static_correction = static_correction;
+    if cubature {
+        solver.force_evaluation = ForceEvaluation::Cubature;
+    }
     solver
 }
 
 fn main() {
-    let Args { sizes, modes, corrections, selections } = parse_args().unwrap_or_else(|e| {
+    let Args { sizes, modes, corrections, selections, cubature } = parse_args().unwrap_or_else(|e| {
         eprintln!("setup_vs_mesh: {e} (sizes are numbers of nodes per side)");
-        eprintln!("usage: setup_vs_mesh [n...] [--modes r] [--lowest | --load | --trained] [--no-correction | --only-correction]");
+        eprintln!("usage: setup_vs_mesh [n...] [--modes r] [--lowest | --load | --trained] [--no-correction | --only-correction] [--cubature]");
         std::process::exit(2)
     });
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    println!("cloth-3d, n x n nodes, {modes} modes, {threads} threads available");
+    let forces = if cubature { "cubature" } else { "exact" };
+    println!("cloth-3d, n x n nodes, {modes} modes, {forces} forces, {threads} threads available");
     println!("{:>5} {:>8} {:>7} {:>10} {:>8} {:>8} {:>8} {:>10}", "n", "dofs", "select", "correction", "basis_s", "setup_s", "other_s", "omega_1");
     for &n in &sizes {
         for &selection in &selections {
             for &static_correction in &corrections {
-                let setup = canonical_scenes::cloth(n, n).with_settings(solver(modes, selection, static_correction));
+                let setup = canonical_scenes::cloth(n, n).with_settings(solver(modes, selection, static_correction, cubature));
                 let select = selection.name();
                 let correction = if static_correction { "static" } else { "none" };
                 let scene = setup.grid.build().expect("cloth scene");

@@ -14,7 +14,8 @@
 //! of the same kind (the margin keeps other poses of that kind within the
 //! tolerance). Everything is seeded, so the set is the same on every machine.
 
-use ndarray::{Array1, Array2};
+use faer::{Col, Mat};
+use ndarray::{Array1, Array2, ShapeBuilder};
 use rand_chacha::rand_core::{RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -230,11 +231,21 @@ fn select<const D: usize>(space: &Modal<Exact>, tol: f64, train_poses: &[Vec<f64
 
 /// The weights of the chosen springs: the non-negative least-squares fit
 /// of their columns to `target` (Lawson-Hanson), on columns scaled to unit
-/// norm.
+/// norm. With more rows than springs the fit runs on the triangle R of
+/// A = Q R and on Qᵀ b (faer's Householder QR): |A x − b|² = |R x − Qᵀ b|²
+/// + |b|² − |Qᵀ b|², the same minimizer on a square system.
 fn fit<const D: usize>(chosen: &[Chosen<D>], target: &[f64]) -> Result<Vec<f64>, PhysicsError> {
     let norms: Vec<f64> = chosen.iter().map(|c| norm(&c.1)).collect();
-    let a = Array2::from_shape_fn((target.len(), chosen.len()), |(i, j)| chosen[j].1[i] / norms[j]);
-    let b = Array1::from(target.to_vec());
+    let (m, k) = (target.len(), chosen.len());
+    let (a, b) = if m > k {
+        let a = Mat::from_fn(m, k, |i, j| chosen[j].1[i] / norms[j]);
+        let qr = a.qr();
+        let qtb = qr.compute_thin_Q().transpose() * Col::from_fn(m, |i| target[i]);
+        let r = qr.thin_R();
+        (Array2::from_shape_fn((k, k).f(), |(i, j)| r[(i, j)]), Array1::from_shape_fn(k, |i| qtb[i]))
+    } else {
+        (Array2::from_shape_fn((m, k).f(), |(i, j)| chosen[j].1[i] / norms[j]), Array1::from(target.to_vec()))
+    };
     // The solver panics where round-off leaves a weight it holds non-positive.
     let (x, _) = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| nnls::nnls(a.view(), b.view())))
         .map_err(|_| PhysicsError::LinearAlgebra { what: "the non-negative least squares of the cubature weights", detail: "round-off".into() })?;
