@@ -444,6 +444,11 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// set-up's or larger than 1 + s times it), with a
     /// hundredth of slack for round-off.
     fn outside_program(&self) -> bool {
+        self.outside(&self.loads)
+    }
+
+    /// Whether `loads` are outside the training program ([`Self::outside_program`]).
+    fn outside(&self, loads: &Loads) -> bool {
         let t = &self.settings.training;
         let slack = 0.01;
         let angle = |a: &[f64; 3], b: &[f64; 3]| -> f64 {
@@ -454,7 +459,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
                 0.0
             }
         };
-        let (g0, g) = (&self.setup_gravity, &self.loads.gravity);
+        let (g0, g) = (&self.setup_gravity, &loads.gravity);
         let n0 = dot(g0, g0).sqrt();
         if n0 > 0.0 {
             let scale = dot(g, g).sqrt() / n0;
@@ -464,7 +469,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
         }
         let d = self.reduced.space.scene().dim;
         let planar = |p: &[f64; 3]| -> [f64; 3] { std::array::from_fn(|i| if i < d { p[i] } else { 0.0 }) };
-        let (p0, p) = (planar(&self.setup_point_load), planar(&self.loads.point_load));
+        let (p0, p) = (planar(&self.setup_point_load), planar(&loads.point_load));
         let (m0, m) = (dot(&p0, &p0).sqrt(), dot(&p, &p).sqrt());
         m > 0.0 && (m0 == 0.0 || m > (1.0 + t.scale) * (1.0 + slack) * m0 || angle(&p0, &p) > 1e-6)
     }

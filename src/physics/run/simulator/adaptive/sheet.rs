@@ -58,6 +58,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
         edit(&mut self.loads);
         let checked =
             self.loads.validate(self.settings.n_modes).and_then(|()| self.loads.validate_on(self.reduced.scene())).and_then(|()| unweighted(&self.loads));
+        let caught_up = if checked.is_ok() { self.estimate_before_leaving() } else { None };
         let host = &self.loads;
         let applied =
             checked.and_then(|()| self.reduced.edit_loads(&mut |l| copy_loads(l, host))).and_then(|()| self.full.edit_loads(&mut |l| copy_loads(l, host)));
@@ -67,6 +68,9 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
             // Both runs accept the loads they had.
             let _ = self.reduced.edit_loads(&mut |l| copy_loads(l, host));
             let _ = self.full.edit_loads(&mut |l| copy_loads(l, host));
+            if let Some(kept) = caught_up {
+                self.undo_estimate(kept);
+            }
             return Err(e);
         }
         if !self.loads.same_but_anchor(&self.spare) {
@@ -377,6 +381,41 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
 }
 
 impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
+    /// Loads that leave the training program (`self.loads`, the ones before
+    /// them in `spare`) make the next step fall back with the error
+    /// estimated so far: the reduced steps since the last estimate are
+    /// estimated first, under the loads they ran with (the reduced run's
+    /// still), or the twin would start without the error they made (up to
+    /// [`super::LONGEST_GAP`] steps of it). What the estimate changed, for
+    /// [`Self::undo_estimate`] (the error's old value in `spare_error`); an
+    /// estimate that fails leaves the run as it was.
+    fn estimate_before_leaving(&mut self) -> Option<BeforeEstimate> {
+        if self.in_full || !self.reduces() || self.wait == 0 || !self.outside_program() || self.outside(&self.spare) {
+            return None;
+        }
+        self.spare_error.copy_from(&self.error);
+        let kept = BeforeEstimate {
+            tally: self.tally,
+            counts: [self.wait, self.gap],
+            sums: [self.since, self.last_error_sq, self.last_motion_sq, self.unseen_sq, self.unseen_last],
+        };
+        match self.estimate() {
+            Ok(()) => Some(kept),
+            Err(_) => {
+                self.undo_estimate(kept);
+                None
+            }
+        }
+    }
+
+    /// The run as it was before [`Self::estimate_before_leaving`].
+    fn undo_estimate(&mut self, kept: BeforeEstimate) {
+        self.error.copy_from(&self.spare_error);
+        self.tally = kept.tally;
+        [self.wait, self.gap] = kept.counts;
+        [self.since, self.last_error_sq, self.last_motion_sq, self.unseen_sq, self.unseen_last] = kept.sums;
+    }
+
     /// A reduced step held: counted in `stretch`, which counts the reduced
     /// steps since the return while the run is reduced (at most [`LONGEST_STRETCH`]).
     fn held_reduced(&mut self) {
@@ -396,4 +435,15 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             self.failed_return();
         }
     }
+}
+
+/// What an estimate changes besides the error ([`Adaptive::undo_estimate`];
+/// the full-space error model's linearization point stays where the
+/// estimate put it: every estimate linearizes again before it advances, so
+/// no step reads it).
+#[derive(Clone, Copy)]
+struct BeforeEstimate {
+    tally: super::Tally,
+    counts: [u64; 2],
+    sums: [f64; 5],
 }
