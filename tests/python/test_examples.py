@@ -7,7 +7,7 @@ import sys
 
 import pytest
 
-from conftest import ROOT
+from conftest import ROOT, fmu_path
 
 EXAMPLES = ROOT / "python" / "examples"
 
@@ -76,3 +76,19 @@ def test_two_hands(default_fmu, tmp_path):
     # The 3D variant: the hands swing across the plane, and the forces have a z component.
     out = run("two_hands.py", default_fmu, "--dimension", "3", "--seconds", "0.5", "--out", "", "--still", "")
     assert "nodes in 3D" in out and re.search(r"\(anchor2Force\): x \S+ to \S+, y \S+ to \S+, z ", out), out
+
+
+def test_adaptive_check():
+    """Through fmpy, cloth 30 x 30 against full space at 0.0005 s: inside the
+    training program E <= 0.01 with at least 90 % of the steps reduced, far
+    outside it E <= 0.02; errorEstimate within [E/3, 3E] (or both below a
+    tenth of the tolerance, 0.001)."""
+    out = run("adaptive_check.py", str(fmu_path("cloth-3d")))
+    rows = re.findall(r"^(.+?): E (\S+) errorEstimate (\S+) reducedFraction (\S+)", out, re.M)
+    assert len(rows) == 4, out
+    for name, e, estimate, reduced in rows:
+        e, estimate, reduced = float(e), float(estimate), float(reduced)
+        inside = name in ("canonical", "0.85 g tilted 10 deg")
+        assert e <= (0.01 if inside else 0.02), out
+        assert reduced >= 0.9 if inside else reduced == 0.0, out
+        assert estimate >= e / 3 and (estimate <= 3 * e or estimate <= 0.001), out

@@ -82,6 +82,8 @@ struct Fresh {
     velocities: bool,
     potential: bool,
     residual: bool,
+    /// The reported modal coordinates (Φᵀ M (x − x*) in full space: O(n r)).
+    coordinates: bool,
 }
 
 /// Space `S` integrated by scheme `I`, and everything that changes while it runs.

@@ -297,7 +297,11 @@ impl<S: Readout, I: Scheme> Reads for Run<S, I> {
         self.outputs.force_residual
     }
 
-    fn modal_coordinates(&self) -> &[f64] {
+    fn modal_coordinates(&mut self) -> &[f64] {
+        if !self.fresh.coordinates {
+            self.space.modal_coordinates(&self.state.y, &mut self.outputs.modal_coordinates);
+            self.fresh.coordinates = true;
+        }
         &self.outputs.modal_coordinates
     }
 

@@ -102,8 +102,9 @@ pub trait Reads {
     /// The part of the physical force the basis cannot represent, relative
     /// to the load (0 in full space); computed when first asked after a step.
     fn force_residual(&mut self) -> f64;
-    /// Coordinates of the kept (modal) or reported (full) modes.
-    fn modal_coordinates(&self) -> &[f64];
+    /// Coordinates of the kept (modal) or reported (full) modes; computed
+    /// when first asked after a step (in full space Φᵀ M (x − x*), O(n r)).
+    fn modal_coordinates(&mut self) -> &[f64];
     /// The spring force at generalized coordinates `y` as the space
     /// evaluates it: Phi^T f(x* + Phi y) in the modal space (every spring,
     /// or the cubature), f(x_rest + y) in full space. For diagnostics; the

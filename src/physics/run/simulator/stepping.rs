@@ -338,7 +338,6 @@ impl<S: Readout, I: Scheme> Run<S, I> {
             let p = self.space.momentum(&self.state.v);
             relative + (0..3).map(|i| c[i] * p[i] + 0.5 * self.free_mass * c[i] * c[i]).sum::<f64>()
         };
-        self.space.modal_coordinates(&self.state.y, &mut self.outputs.modal_coordinates);
         self.energy = relative + self.model_energy_now().abs();
     }
 }

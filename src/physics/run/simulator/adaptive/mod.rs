@@ -202,6 +202,8 @@ pub struct Adaptive<F: ReducedForce, R: Scheme, X: Scheme> {
     reported_rows: Vec<f64>,
     frequencies: Vec<f64>,
     coordinates: Vec<f64>,
+    /// `coordinates` are those of the state (computed when first read after a change).
+    coordinates_fresh: bool,
     /// Fall-backs and returns so far, and the last (for the host's log; not part of the state).
     switches: u64,
     last_switch: Switch,
@@ -290,6 +292,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             reported_rows: vec![0.0; n * settings.n_modes],
             frequencies: vec![0.0; settings.n_modes],
             coordinates: vec![0.0; settings.n_modes],
+            coordinates_fresh: false,
             chosen,
             switches: 0,
             last_switch: Switch::None,
@@ -305,7 +308,6 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             run.lift();
         }
         run.report_basis();
-        run.report_coordinates();
         Ok(run)
     }
 
@@ -348,7 +350,8 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// run's own, or Φᵀ M (x − x*) of the full-space state (M (x − x*) into
     /// the residual's scratch, then faer's matrix-vector product over the
     /// vectors as rows: k dot products of length n, where the columns of
-    /// Φᵀ, k long, made it 13 % of a run in full space on cloth 30 x 30 at k = 2).
+    /// Φᵀ, k long, made it 13 % of a run in full space on cloth 30 x 30 at k = 2);
+    /// when the host reads them, not after every step.
     fn report_coordinates(&mut self) {
         let k = self.coordinates.len();
         if !self.in_full {

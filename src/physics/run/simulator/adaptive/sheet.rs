@@ -81,13 +81,13 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
 
     fn displace(&mut self, dy: &[f64]) -> Result<(), PhysicsError> {
         self.active_mut().displace(dy)?;
-        self.report_coordinates();
+        self.coordinates_fresh = false;
         Ok(())
     }
 
     fn displace_dofs(&mut self, dy: &[f64]) -> Result<(), PhysicsError> {
         self.active_mut().displace_dofs(dy)?;
-        self.report_coordinates();
+        self.coordinates_fresh = false;
         Ok(())
     }
 
@@ -210,7 +210,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Steps for Adaptive<F, R, X> {
             self.restore_twin(&part.error)?;
             self.spare_error = self.error.clone();
         }
-        self.report_coordinates();
+        self.coordinates_fresh = false;
         Ok(())
     }
 }
@@ -260,7 +260,11 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Reads for Adaptive<F, R, X> {
         self.active_mut().force_residual()
     }
 
-    fn modal_coordinates(&self) -> &[f64] {
+    fn modal_coordinates(&mut self) -> &[f64] {
+        if !self.coordinates_fresh {
+            self.report_coordinates();
+            self.coordinates_fresh = true;
+        }
         &self.coordinates
     }
 
@@ -323,16 +327,16 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> SetUp for Adaptive<F, R, X> {
 impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// One communication step, reduced or in full space (see the module documentation).
     fn step_either(&mut self, h: f64) -> Result<(), PhysicsError> {
+        // Any step, taken or failed, may move the state the coordinates are read from.
+        self.coordinates_fresh = false;
         if self.in_full {
-            self.step_full(h)?;
-            self.report_coordinates();
-            return Ok(());
+            return self.step_full(h);
         }
         if self.outside_program() {
             // A basis trained for other loads: full space from the start of the step.
             self.switched(Switch::FallBack { time: self.reduced.state.time, why: FallBackCause::OutsideProgram });
             self.lift();
-            return self.step_full(h).inspect(|_| self.report_coordinates());
+            return self.step_full(h);
         }
         let due = self.wait + 1 >= self.gap.min(self.check_gap());
         if due {
@@ -375,7 +379,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             self.twin_live = false;
             return Err(e);
         }
-        self.report_coordinates();
+        self.coordinates_fresh = false;
         Ok(())
     }
 }
@@ -420,7 +424,7 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// steps since the return while the run is reduced (at most [`LONGEST_STRETCH`]).
     fn held_reduced(&mut self) {
         self.stretch = (self.stretch + 1).min(LONGEST_STRETCH);
-        self.report_coordinates();
+        self.coordinates_fresh = false;
     }
 
     /// Falling back after a return that held for fewer communication steps
