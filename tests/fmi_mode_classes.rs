@@ -175,3 +175,35 @@ fn mode_shapes_are_the_basis_the_fmu_runs_in() {
         assert_eq!(bits(&f.f64s(vr::MODE_SHAPES, r * n * d)), bits(&phi));
     }
 }
+
+/// Full space makes the modes it reports when they are first read: a
+/// set-up whose nModes the eigensolvers cannot give (cloth 60 x 60 in 3D,
+/// 10 620 free DOFs, 700 modes: more than the partial solver takes, too
+/// many DOFs for the dense one) sets up and steps; reading a mode output is
+/// refused with the reason, and the run goes on from where it was.
+#[test]
+fn full_space_makes_its_reported_modes_when_they_are_read() {
+    let f = Fmu::new();
+    for (r, x) in [(vr::NX, 60), (vr::NY, 60), (vr::DIMENSION, 3), (vr::N_MODES, 700)] {
+        assert_eq!(f.set_u64(r, x), OK);
+    }
+    assert_eq!(f.set_i64(vr::REDUCTION, 2), OK);
+    f.init();
+    assert_eq!(f.step(0.0, 0.01), OK, "{:?}", f.messages());
+    let before = f.positions();
+    for r in [vr::MODAL_COORDINATES, vr::MODE_FREQUENCIES] {
+        let (s, _) = f.get_f64(r, 700);
+        f.refused(s, "the nModes = 700 reported modes cannot be made");
+    }
+    assert_eq!(bits(&f.positions()), bits(&before));
+    assert_eq!(f.step(0.01, 0.01), OK, "{:?}", f.messages());
+    // With modes it can make, it reports them as the modal space keeps them.
+    let g = Fmu::new();
+    assert_eq!(g.set_u64(vr::N_MODES, 6), OK);
+    assert_eq!(g.set_i64(vr::REDUCTION, 2), OK);
+    g.init();
+    let m = Fmu::new();
+    assert_eq!(m.set_u64(vr::N_MODES, 6), OK);
+    m.init();
+    assert_eq!(bits(&g.f64s(vr::MODE_FREQUENCIES, 6)), bits(&m.f64s(vr::MODE_FREQUENCIES, 6)));
+}

@@ -15,6 +15,8 @@ use crate::bytes::Reader;
 pub enum Computed<'a> {
     Scalar(f64),
     Array(&'a [f64]),
+    /// The value cannot be given, and why (the glue logs it and returns fmi3Error).
+    Refused(String),
 }
 
 /// How a communication step ended that the model took.

@@ -84,6 +84,7 @@ impl Instance {
             } else {
                 match self.model.output(r, self.start_time) {
                     Computed::Scalar(x) => out[k] = conv(x),
+                    Computed::Refused(why) => return Err(self.log.fail(&format!("{}: {}: {why}", f.name(), v.name))),
                     Computed::Array(a) => {
                         if a.len() != n {
                             return Err(self.log.fail(&format!("{}: {} holds {} values, expected {n}", f.name(), v.name, a.len())));

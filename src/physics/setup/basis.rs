@@ -255,6 +255,20 @@ fn tangent_entry(d: &[f64], k: f64, l0: f64, r: usize, c: usize) -> f64 {
     k * (uu + (1.0 - l0 / l) * (id - uu))
 }
 
+/// What [`build`] refuses before any work: more modes than free DOFs, and
+/// a selection that needs a load (`load`, the static correction) without one.
+pub fn refuse_early(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) -> Result<(), PhysicsError> {
+    let n = scene.n_dofs();
+    if n_modes > n {
+        return Err(PhysicsError::ModesExceedDofs { modes: n_modes, dofs: n });
+    }
+    let needs_load = settings.mode_selection == ModeSelection::Load || settings.static_correction;
+    if needs_load && load_patterns(scene, loads, settings.anchor_motion, settings.anchor_rotation).is_empty() {
+        return Err(PhysicsError::NoLoad);
+    }
+    Ok(())
+}
+
 /// The basis of `n_modes` vectors on `scene` under `loads`, chosen and
 /// linearized as `settings` ask (`mode_selection`, `static_correction`,
 /// `linearization`, `anchor_motion`). A trained basis comes from its
@@ -263,9 +277,7 @@ fn tangent_entry(d: &[f64], k: f64, l0: f64, r: usize, c: usize) -> f64 {
 /// modes are reported.
 pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) -> Result<Basis, PhysicsError> {
     let n = scene.n_dofs();
-    if n_modes > n {
-        return Err(PhysicsError::ModesExceedDofs { modes: n_modes, dofs: n });
-    }
+    refuse_early(scene, loads, n_modes, settings)?;
     let (point, pattern, stiffness) = linearize(scene, loads, settings)?;
     let at_rest = settings.linearization == Linearization::Rest;
     let patterns = load_patterns(scene, loads, settings.anchor_motion, settings.anchor_rotation);
@@ -273,10 +285,6 @@ pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) 
         ModeSelection::Trained => ModeSelection::Lowest,
         other => other,
     };
-    let needs_load = selection == ModeSelection::Load || settings.static_correction;
-    if needs_load && patterns.is_empty() {
-        return Err(PhysicsError::NoLoad);
-    }
     let constraints = constraint_vectors(scene, &pattern, &stiffness, &point, settings)?;
     let plain = selection == ModeSelection::Lowest && !settings.static_correction && constraints.is_empty();
     let modes = if plain {

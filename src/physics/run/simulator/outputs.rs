@@ -323,7 +323,13 @@ impl<S: Readout, I: Scheme> Reads for Run<S, I> {
 
 impl<S: Readout, I: Scheme> SetUp for Run<S, I> {
     fn mode_frequencies(&self) -> &[f64] {
+        // The full space's reported modes are made when first asked for.
+        let _ = self.space.modes_made();
         self.space.layout().frequencies
+    }
+
+    fn modes_made(&self) -> Result<(), &PhysicsError> {
+        self.space.modes_made()
     }
 
     fn mode_shapes(&self) -> Option<&ModalBasis> {

@@ -121,6 +121,12 @@ pub trait Reads {
 pub trait SetUp {
     /// omega_i of the kept or reported modes, ascending [rad/s].
     fn mode_frequencies(&self) -> &[f64];
+    /// Makes the reported modes of a full-space run, which are made when
+    /// first asked for, and says why they cannot be, if they cannot (then
+    /// the mode outputs are empty or 0).
+    fn modes_made(&self) -> Result<(), &PhysicsError> {
+        Ok(())
+    }
     /// The kept (modal) or reported (full) modes: shapes Phi (row-major n x r over the free DOFs), lambda_i.
     fn mode_shapes(&self) -> Option<&ModalBasis>;
     /// Out-of-plane share and mirror symmetry of each mode of [`Self::mode_shapes`] (empty without). O(n r).

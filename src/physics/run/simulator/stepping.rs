@@ -154,13 +154,14 @@ impl<S: Readout, I: Scheme> Run<S, I> {
     /// The space's coordinates of a displacement `u` of the free DOFs: its
     /// modal coordinates Phi^T M u (the part the basis holds), or u itself in full space.
     fn coordinates_of(&self, u: &[f64]) -> Vec<f64> {
-        match (self.space.layout().kept_modes, self.space.modes()) {
-            (Some(r), Some(basis)) => {
+        // Full space keeps no modes (its reported ones are not asked for here).
+        match self.space.layout().kept_modes.and_then(|r| self.space.modes().map(|b| (r, b))) {
+            Some((r, basis)) => {
                 let mut q = vec![0.0; r];
                 basis.project_displacement(&self.space.scene().dof_mass, u, &mut q);
                 q
             }
-            _ => u.to_vec(),
+            None => u.to_vec(),
         }
     }
 

@@ -2,6 +2,7 @@
 //! outputs, each method with the equation it computes; and [`Diagonal`],
 //! the linear part of the equations where it is diagonal.
 
+use crate::physics::error::PhysicsError;
 use crate::physics::error::StepFailure;
 use crate::physics::run::frame::{Frame, Moments};
 use crate::physics::run::state::Loads;
@@ -54,9 +55,15 @@ pub trait Constants {
     fn setup_data(&self) -> Option<SetupData> {
         None
     }
-    /// The kept (modal) or reported (full) modes, if any.
+    /// The kept (modal) or reported (full) modes, if any (in full space made
+    /// when first asked for: [`Self::modes_made`]).
     fn modes(&self) -> Option<&ModalBasis> {
         None
+    }
+    /// Makes the modes where they are made when first asked for (the full
+    /// space's reported modes), and says why they cannot be, if they cannot.
+    fn modes_made(&self) -> Result<(), &PhysicsError> {
+        Ok(())
     }
     /// The coordinates of the scene at rest, where every run starts (0
     /// unless the coordinates are measured from another point than rest).

@@ -14,6 +14,7 @@ use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LdltRef, LltRe
 use faer::sparse::SymbolicSparseColMatRef;
 use faer::{Conj, MatMut, Par, Side};
 use rayon::prelude::*;
+use std::sync::OnceLock;
 
 mod linear;
 mod readout;
@@ -38,11 +39,11 @@ pub struct Full {
     /// Upper triangle of K0, the stiffness at x*.
     k0: Vec<f64>,
     symbolic: SymbolicCholesky<usize>,
-    /// Modes whose coordinates and frequencies are reported, if any.
-    reported: Option<ModalBasis>,
-    /// x_rest - x* of the reported modes, when x* is not the rest positions.
-    reported_offset: Option<Vec<f64>>,
-    frequencies: Vec<f64>,
+    /// The modes whose coordinates and frequencies are reported, made when
+    /// first asked for ([`Constants::modes_made`]): what they are made from,
+    /// and the result.
+    reported_from: Option<(Loads, Settings)>,
+    reported: OnceLock<Result<Reported, PhysicsError>>,
     omega_sq_bound: f64,
     newton_scale: f64,
     /// The pivot X0.
@@ -57,6 +58,14 @@ pub struct Full {
 
 /// DOFs per task of the parallel node updates.
 const NODE_TASK: usize = 4096;
+
+/// The reported modes of a full-space run.
+struct Reported {
+    modes: ModalBasis,
+    /// x_rest - x* of the modes, when x* is not the rest positions.
+    offset: Option<Vec<f64>>,
+    frequencies: Vec<f64>,
+}
 
 /// No entry in the pattern.
 const SKIP: usize = usize::MAX;
@@ -106,18 +115,19 @@ impl AsMut<Loads> for FullWork {
 }
 
 impl Full {
-    /// Assembles the stiffness at rest and its symbolic Cholesky analysis;
-    /// builds the basis of `reported_modes` vectors `options` ask for (under
-    /// the set-up `loads`) when that is not 0, to report its coordinates.
+    /// Assembles the stiffness at rest and its symbolic Cholesky analysis.
+    /// The basis of the `settings.n_modes` vectors the settings ask for
+    /// (under the set-up `loads`), whose coordinates and frequencies are
+    /// reported, is made when first asked for: a run that does not read
+    /// them does not pay for them (on cloth 30 x 30, 900 of them took 3.5 s
+    /// of set-up). What can be refused without making it is refused here.
     pub fn new(scene: Scene, loads: &Loads, settings: &Settings) -> Result<Self, PhysicsError> {
-        let reported_modes = settings.n_modes;
         let (pattern, k0) = linearize(&scene);
-        let (reported, reported_offset) = if reported_modes > 0 {
-            let b = basis::build(&scene, loads, reported_modes, settings)?;
-            let offset = (!b.at_rest).then(|| (0..scene.n_dofs()).map(|k| scene.rest[k] - b.point[k]).collect());
-            (Some(b.modes), offset)
+        let reported_from = if settings.n_modes > 0 {
+            basis::refuse_early(&scene, loads, settings.n_modes, settings)?;
+            Some((loads.clone(), settings.clone()))
         } else {
-            (None, None)
+            None
         };
         let n = scene.n_dofs();
         let sym = SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx);
@@ -141,11 +151,10 @@ impl Full {
             pivot: scene.pivot(),
             node_pairs,
             springs: SpringForces::new(&scene),
-            frequencies: reported.as_ref().map(|b| b.frequencies()).unwrap_or_default(),
             omega_sq_bound: omega_sq_bound_full(&scene),
             newton_scale: scene.length_scale().max(1e-300),
-            reported,
-            reported_offset,
+            reported_from,
+            reported: OnceLock::new(),
             symbolic,
             pattern,
             k0,
@@ -155,6 +164,16 @@ impl Full {
 }
 
 impl Full {
+    /// The reported modes, made if they are not yet (`None`: none asked for).
+    fn reported(&self) -> Option<&Result<Reported, PhysicsError>> {
+        let (loads, settings) = self.reported_from.as_ref()?;
+        Some(self.reported.get_or_init(|| {
+            let b = basis::build(&self.scene, loads, settings.n_modes, settings)?;
+            let offset = (!b.at_rest).then(|| (0..self.scene.n_dofs()).map(|k| self.scene.rest[k] - b.point[k]).collect());
+            Ok(Reported { frequencies: b.modes.frequencies(), modes: b.modes, offset })
+        }))
+    }
+
     /// h = f_springs(x) + M g + f_p at the slot positions in `w` (gravity
     /// and the springs in one pass, as adding the springs to a copy of
     /// gravity); turning, the centrifugal force joins it.
@@ -189,14 +208,22 @@ impl Constants for Full {
             coordinates: self.scene.n_dofs(),
             kept_modes: None,
             springs: self.scene.springs.len(),
-            frequencies: &self.frequencies,
+            // Those of the reported modes once made (Constants::modes_made).
+            frequencies: self.reported.get().and_then(|r| r.as_ref().ok()).map_or(&[], |r| &r.frequencies),
             newton_scale: self.newton_scale,
             trained: None,
         }
     }
 
     fn modes(&self) -> Option<&ModalBasis> {
-        self.reported.as_ref()
+        self.reported().and_then(|r| r.as_ref().ok()).map(|r| &r.modes)
+    }
+
+    fn modes_made(&self) -> Result<(), &PhysicsError> {
+        match self.reported() {
+            Some(Err(e)) => Err(e),
+            _ => Ok(()),
+        }
     }
 
     /// u = 0: the full space measures from the rest positions.

@@ -85,14 +85,15 @@ impl Readout for Full {
         0.0
     }
 
-    /// q = Phi^T M (x - x*) on the reported modes.
+    /// q = Phi^T M (x - x*) on the reported modes (made when first asked
+    /// for; 0 where they cannot be, which [`Constants::modes_made`] says).
     fn modal_coordinates(&self, u: &[f64], out: &mut [f64]) {
-        if let Some(b) = &self.reported {
-            match &self.reported_offset {
-                None => b.project_displacement(&self.scene.dof_mass, u, out),
+        if let Some(Ok(r)) = self.reported() {
+            match &r.offset {
+                None => r.modes.project_displacement(&self.scene.dof_mass, u, out),
                 Some(offset) => {
                     let d: Vec<f64> = u.iter().zip(offset).map(|(a, b)| a + b).collect();
-                    b.project_displacement(&self.scene.dof_mass, &d, out);
+                    r.modes.project_displacement(&self.scene.dof_mass, &d, out);
                 }
             }
         }
