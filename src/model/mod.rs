@@ -470,7 +470,8 @@ fn component(v: Option<[f64; 3]>, i: usize) -> f64 {
 /// Every output of the simulator is a finite number.
 pub fn outputs_finite(sim: &mut Simulator) -> bool {
     let finite = |a: &[f64]| a.iter().all(|x| x.is_finite());
-    // The modal coordinates are Φᵀ M (x − x*) of the positions (or give
-    // them), and full space makes its reported modes when first read.
+    // The modal coordinates are not read here: they are finite with the
+    // positions (Φᵀ M (x − x*) in full space, x = x* + Φ q in the modal
+    // space), and full space makes its reported modes only when they are read.
     finite(sim.positions()) && finite(sim.velocities()) && sim.kinetic_energy().is_finite() && sim.potential_energy().is_finite()
 }

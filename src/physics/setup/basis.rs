@@ -256,17 +256,19 @@ fn tangent_entry(d: &[f64], k: f64, l0: f64, r: usize, c: usize) -> f64 {
 }
 
 /// What [`build`] refuses before any work: more modes than free DOFs, and
-/// a selection that needs a load (`load`, the static correction) without one.
-pub fn refuse_early(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) -> Result<(), PhysicsError> {
+/// a selection that needs a load (`load`, the static correction) without
+/// one; else the load patterns ([`load_patterns`]) it looked at.
+pub fn refuse_early(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) -> Result<Vec<Vec<f64>>, PhysicsError> {
     let n = scene.n_dofs();
     if n_modes > n {
         return Err(PhysicsError::ModesExceedDofs { modes: n_modes, dofs: n });
     }
+    let patterns = load_patterns(scene, loads, settings.anchor_motion, settings.anchor_rotation);
     let needs_load = settings.mode_selection == ModeSelection::Load || settings.static_correction;
-    if needs_load && load_patterns(scene, loads, settings.anchor_motion, settings.anchor_rotation).is_empty() {
+    if needs_load && patterns.is_empty() {
         return Err(PhysicsError::NoLoad);
     }
-    Ok(())
+    Ok(patterns)
 }
 
 /// The basis of `n_modes` vectors on `scene` under `loads`, chosen and
@@ -277,10 +279,9 @@ pub fn refuse_early(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Set
 /// modes are reported.
 pub fn build(scene: &Scene, loads: &Loads, n_modes: usize, settings: &Settings) -> Result<Basis, PhysicsError> {
     let n = scene.n_dofs();
-    refuse_early(scene, loads, n_modes, settings)?;
+    let patterns = refuse_early(scene, loads, n_modes, settings)?;
     let (point, pattern, stiffness) = linearize(scene, loads, settings)?;
     let at_rest = settings.linearization == Linearization::Rest;
-    let patterns = load_patterns(scene, loads, settings.anchor_motion, settings.anchor_rotation);
     let selection = match settings.mode_selection {
         ModeSelection::Trained => ModeSelection::Lowest,
         other => other,

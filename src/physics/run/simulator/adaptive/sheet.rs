@@ -379,7 +379,6 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
             self.twin_live = false;
             return Err(e);
         }
-        self.coordinates_fresh = false;
         Ok(())
     }
 }
@@ -424,7 +423,6 @@ impl<F: ReducedForce, R: Scheme, X: Scheme> Adaptive<F, R, X> {
     /// steps since the return while the run is reduced (at most [`LONGEST_STRETCH`]).
     fn held_reduced(&mut self) {
         self.stretch = (self.stretch + 1).min(LONGEST_STRETCH);
-        self.coordinates_fresh = false;
     }
 
     /// Falling back after a return that held for fewer communication steps
